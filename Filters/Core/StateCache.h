@@ -1,0 +1,94 @@
+// Bounded cache of simulation states keyed by output-step index, shared by the time-dependent sources.
+//
+// The sources report output times t_k = k * OutputInterval. A request for step k restores the cached state of
+// the largest cached step <= k and simulates forward from there, so scrubbing the time slider backwards or
+// revisiting a time never re-simulates from t = 0. The cache holds at most `capacity` states; when full it
+// evicts so that the kept steps stay spread over the timeline (it drops the entry whose removal leaves the
+// smallest gap, never step 0), which bounds the forward re-simulation after a jump back.
+// A property change must call Clear().
+#ifndef meshfree_StateCache_h
+#define meshfree_StateCache_h
+
+#include <cstddef>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <utility>
+
+namespace meshfree
+{
+
+template <typename State>
+class StateCache
+{
+public:
+  explicit StateCache(std::size_t capacity = 16)
+    : Capacity(capacity < 2 ? 2 : capacity)
+  {
+  }
+
+  void SetCapacity(std::size_t capacity)
+  {
+    this->Capacity = capacity < 2 ? 2 : capacity;
+    while (this->States.size() > this->Capacity)
+    {
+      this->EvictOne();
+    }
+  }
+  std::size_t GetCapacity() const { return this->Capacity; }
+  std::size_t Size() const { return this->States.size(); }
+  void Clear() { this->States.clear(); }
+  bool Contains(long step) const { return this->States.count(step) != 0; }
+
+  /// The cached state with the largest step <= `step`, or nullptr. `foundStep` receives its step.
+  const State* FindAtOrBefore(long step, long& foundStep) const
+  {
+    auto it = this->States.upper_bound(step);
+    if (it == this->States.begin())
+    {
+      return nullptr;
+    }
+    --it;
+    foundStep = it->first;
+    return &it->second;
+  }
+
+  void Insert(long step, State state)
+  {
+    this->States[step] = std::move(state);
+    while (this->States.size() > this->Capacity)
+    {
+      this->EvictOne();
+    }
+  }
+
+private:
+  // Remove the interior entry whose neighbours are closest together (the least informative checkpoint);
+  // keep the first (step 0, the initial state) and the last (the most recent) entries.
+  void EvictOne()
+  {
+    if (this->States.size() <= 2)
+    {
+      return;
+    }
+    auto best = this->States.end();
+    long bestGap = std::numeric_limits<long>::max();
+    for (auto it = std::next(this->States.begin()); std::next(it) != this->States.end(); ++it)
+    {
+      const long gap = std::next(it)->first - std::prev(it)->first;
+      if (gap < bestGap)
+      {
+        bestGap = gap;
+        best = it;
+      }
+    }
+    this->States.erase(best);
+  }
+
+  std::size_t Capacity;
+  std::map<long, State> States;
+};
+
+} // namespace meshfree
+
+#endif

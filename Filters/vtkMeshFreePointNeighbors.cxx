@@ -1,0 +1,145 @@
+#include "vtkMeshFreePointNeighbors.h"
+
+#include "vtkCharArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+
+#include "NeighborGrid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+vtkStandardNewMacro(vtkMeshFreePointNeighbors);
+
+vtkMeshFreePointNeighbors::vtkMeshFreePointNeighbors() = default;
+
+int vtkMeshFreePointNeighbors::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
+  vtkPointSet* output = vtkPointSet::GetData(outputVector);
+  if (!input || !output)
+  {
+    vtkErrorMacro("Missing input or output point set.");
+    return 0;
+  }
+  output->ShallowCopy(input);
+
+  const vtkIdType n = input->GetNumberOfPoints();
+  vtkNew<vtkDoubleArray> meanDistance;
+  meanDistance->SetName("MeanNeighborDistance");
+  meanDistance->SetNumberOfTuples(n);
+  vtkNew<vtkCharArray> valid;
+  valid->SetName("vtkValidPointMask");
+  valid->SetNumberOfTuples(n);
+  vtkNew<vtkIdTypeArray> inRadius;
+  inRadius->SetName("NeighborsInRadius");
+  if (this->SearchRadius > 0)
+  {
+    inRadius->SetNumberOfTuples(n);
+  }
+
+  if (n == 0)
+  {
+    vtkWarningMacro("The input has no points: nothing to compute.");
+  }
+
+  // One copy of the coordinates as doubles: the core takes raw interleaved xyz.
+  std::vector<double> xyz(static_cast<size_t>(3 * n));
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    input->GetPoint(i, &xyz[3 * i]);
+  }
+
+  meshfree::NeighborGrid grid;
+  grid.Build(xyz.data(), n);
+  if (grid.NumberOfInvalidPoints() > 0)
+  {
+    vtkWarningMacro(<< grid.NumberOfInvalidPoints() << " of " << n
+                    << " points have NaN or Inf coordinates: they are ignored and masked out.");
+  }
+
+  const int k = this->NeighborCount;
+  const double radius = this->SearchRadius;
+  double* meanPtr = meanDistance->GetPointer(0);
+  char* validPtr = valid->GetPointer(0);
+  vtkIdType* radiusPtr = radius > 0 ? inRadius->GetPointer(0) : nullptr;
+  const vtkIdType chunk = 4096;
+  for (vtkIdType begin = 0; begin < n; begin += chunk)
+  {
+    if (this->GetAbortExecute())
+    {
+      break;
+    }
+    const vtkIdType end = std::min(n, begin + chunk);
+#pragma omp parallel
+    {
+      std::vector<meshfree::Index> ids(k + 1);
+      std::vector<double> dist2(k + 1);
+      std::vector<meshfree::Index> radiusIds;
+#pragma omp for schedule(dynamic, 256)
+      for (vtkIdType i = begin; i < end; ++i)
+      {
+        const double* x = &xyz[3 * i];
+        const bool finite = std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
+        validPtr[i] = finite ? 1 : 0;
+        meanPtr[i] = 0.0;
+        if (radiusPtr)
+        {
+          radiusPtr[i] = 0;
+        }
+        if (!finite)
+        {
+          continue;
+        }
+        // k + 1 because the point finds itself (and any duplicates of itself) first.
+        const int found = grid.FindKNearest(x, k + 1, ids.data(), dist2.data());
+        double sum = 0.0;
+        int used = 0;
+        bool skippedSelf = false;
+        for (int j = 0; j < found && used < k; ++j)
+        {
+          if (!skippedSelf && ids[j] == i)
+          {
+            skippedSelf = true;
+            continue;
+          }
+          sum += std::sqrt(dist2[j]);
+          ++used;
+        }
+        meanPtr[i] = used > 0 ? sum / used : 0.0;
+        if (radiusPtr)
+        {
+          grid.FindWithinRadius(x, radius, radiusIds);
+          radiusPtr[i] = std::max<vtkIdType>(0, static_cast<vtkIdType>(radiusIds.size()) - 1);
+        }
+      }
+    }
+    this->UpdateProgress(static_cast<double>(end) / n);
+  }
+
+  vtkPointData* pd = output->GetPointData();
+  pd->AddArray(meanDistance);
+  pd->AddArray(valid);
+  if (radius > 0)
+  {
+    pd->AddArray(inRadius);
+  }
+  pd->SetActiveScalars("MeanNeighborDistance");
+  return 1;
+}
+
+void vtkMeshFreePointNeighbors::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "NeighborCount: " << this->NeighborCount << "\n";
+  os << indent << "SearchRadius: " << this->SearchRadius << "\n";
+}
