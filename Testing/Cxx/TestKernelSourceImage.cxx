@@ -52,6 +52,7 @@ int TestKernelSourceImage(int argc, char* argv[])
   renderer->GetActiveCamera()->Elevation(-60);
   renderer->GetActiveCamera()->Azimuth(20);
   renderer->ResetCamera();
+  renderer->GetActiveCamera()->Zoom(1.6);
   window->Render();
 
   int result = vtkRegressionTestImage(window);

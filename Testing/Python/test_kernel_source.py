@@ -18,10 +18,12 @@ for name in names:
         out = meshfree_test.fetch(src)
         value = np.asarray(out.PointData["Value"]).reshape(61, 61)  # [y, x]
         assert np.all(np.isfinite(value)), (name, dim)
-        # Symmetric under x -> -x; in 2D and 3D also under x <-> y.
-        assert np.allclose(value, value[:, ::-1], rtol=1e-12, atol=0), (name, dim)
+        # Symmetric under x -> -x; in 2D and 3D also under x <-> y. The grid's mirrored coordinates agree
+        # only to rounding, so the tolerance is relative to the peak.
+        tol = 1e-10 * np.abs(value).max()
+        assert np.allclose(value, value[:, ::-1], rtol=0, atol=tol), (name, dim)
         if dim > 1:
-            assert np.allclose(value, value.T, rtol=1e-12, atol=0), (name, dim)
+            assert np.allclose(value, value.T, rtol=0, atol=tol), (name, dim)
         # Compact support: zero on the plane's border, which lies beyond h (in 1D only x counts).
         assert np.all(value[:, 0] == 0) and np.all(value[:, -1] == 0), (name, dim)
         if dim > 1:
