@@ -40,10 +40,13 @@ def kernel_profiles(out):
             src.UpdatePipeline()
             data = dsa.WrapDataObject(sm.Fetch(src))
             value = np.asarray(data.PointData["Value"]).reshape(n, n)[n // 2, :]
-            x = np.asarray(data.Points)[:, 0].reshape(n, n)[n // 2, :]
+            origin, spacing = data.VTKObject.GetOrigin(), data.VTKObject.GetSpacing()
+            x = origin[0] + spacing[0] * np.arange(n)
             keep = x >= 0
             ax.plot(x[keep], value[keep], style, label="%dD" % dim)
             simple.Delete(src)
+        if name == "Viscosity":
+            ax.set_ylim(0, 8)  # the kernel is singular at r = 0 (capped): show its body
         ax.set_title(name)
         ax.axvline(1.0, color="0.7", lw=0.8)
         ax.grid(alpha=0.3)
