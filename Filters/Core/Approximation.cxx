@@ -1,0 +1,480 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Approximator: cloud set-up (exclusions, neighbour grid, intrinsic frame), the evaluation loop, LS/WLS and
+// MLS. PU-WLS is in ApproximationPU.cxx, SPH in ApproximationSPH.cxx.
+#include "Approximation.h"
+#include "ApproximationPU.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <stdexcept>
+
+namespace meshfree
+{
+
+const char* ApproximationMethodName(ApproximationMethod method)
+{
+  switch (method)
+  {
+    case ApproximationMethod::LS:
+      return "LS";
+    case ApproximationMethod::WLS:
+      return "WLS";
+    case ApproximationMethod::MLS:
+      return "MLS";
+    case ApproximationMethod::PUWLS:
+      return "PU-WLS";
+    case ApproximationMethod::SPH:
+      return "SPH";
+  }
+  return "Unknown";
+}
+
+bool ApproximationMethodFromName(const std::string& name, ApproximationMethod& out)
+{
+  std::string upper;
+  for (char c : name)
+  {
+    if (c != '-' && c != '_' && c != ' ')
+    {
+      upper += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    }
+  }
+  const struct
+  {
+    const char* Name;
+    ApproximationMethod Method;
+  } table[] = { { "LS", ApproximationMethod::LS }, { "WLS", ApproximationMethod::WLS },
+    { "MLS", ApproximationMethod::MLS }, { "PUWLS", ApproximationMethod::PUWLS },
+    { "SPH", ApproximationMethod::SPH } };
+  for (const auto& entry : table)
+  {
+    if (upper == entry.Name)
+    {
+      out = entry.Method;
+      return true;
+    }
+  }
+  return false;
+}
+
+Approximator::Approximator() = default;
+Approximator::~Approximator() = default;
+
+bool Approximator::SetOptions(const ApproximationOptions& options)
+{
+  if (options.Degree < 0 || options.Degree > kMaxBasisDegree)
+  {
+    this->Err = "BasisDegree must be 0..3";
+    return false;
+  }
+  if (options.NeighborCount < 1)
+  {
+    this->Err = "NeighborCount must be at least 1";
+    return false;
+  }
+  if (!(options.Epsilon > 0.0) || !std::isfinite(options.Epsilon))
+  {
+    this->Err = "Epsilon must be finite and > 0";
+    return false;
+  }
+  if (!(options.SupportFactor >= 1.0) || !std::isfinite(options.SupportFactor))
+  {
+    this->Err = "SupportFactor must be >= 1";
+    return false;
+  }
+  this->Opts = options;
+  if (!(this->Opts.SupportRadius > 0.0) || !std::isfinite(this->Opts.SupportRadius))
+  {
+    this->Opts.SupportRadius = 0.0;
+  }
+  return true;
+}
+
+bool Approximator::SetCloud(
+  const double* xyz, Index n, const double* values, int components, const double* volumes)
+{
+  this->Rep = ApproximationReport();
+  this->Err.clear();
+  this->PU.reset();
+  this->GlobalDegree = -1;
+  n = std::max<Index>(n, 0);
+  components = std::max(components, 0);
+  this->NumberOfComponents = components;
+  this->Coordinates.assign(xyz, xyz + 3 * n);
+  this->Values.assign(values ? values : xyz, values ? values + static_cast<size_t>(n) * components : xyz);
+  this->Volumes.clear();
+  if (volumes)
+  {
+    this->Volumes.assign(volumes, volumes + n);
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Index excluded = 0;
+  // A point whose values (or volume) are not usable is removed from the geometry, so that no fit sees it.
+  for (Index i = 0; i < n; ++i)
+  {
+    double* x = &this->Coordinates[3 * i];
+    bool ok = std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
+    for (int c = 0; ok && c < components; ++c)
+    {
+      ok = std::isfinite(this->Values[static_cast<size_t>(i) * components + c]);
+    }
+    if (ok && volumes)
+    {
+      ok = std::isfinite(volumes[i]) && volumes[i] > 0.0;
+    }
+    if (!ok)
+    {
+      x[0] = x[1] = x[2] = nan;
+      ++excluded;
+    }
+  }
+  this->Rep.CloudPoints = n;
+  this->Rep.ExcludedPoints = excluded;
+  const bool any = this->Points.Build(this->Coordinates.data(), n);
+  this->Points.GetBounds(this->Bounds);
+
+  // Intrinsic frame: PCA of the valid points (two-pass, centred, in double).
+  const Index nv = this->Points.NumberOfValidPoints();
+  const double* sp = this->Points.SortedPoints();
+  double c[3] = { 0, 0, 0 };
+  for (Index i = 0; i < nv; ++i)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      c[a] += sp[3 * i + a];
+    }
+  }
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  if (nv > 0)
+  {
+    for (double& v : c)
+    {
+      v /= static_cast<double>(nv);
+    }
+    for (Index i = 0; i < nv; ++i)
+    {
+      const Eigen::Vector3d d(sp[3 * i] - c[0], sp[3 * i + 1] - c[1], sp[3 * i + 2] - c[2]);
+      cov += d * d.transpose();
+    }
+    cov /= static_cast<double>(nv);
+  }
+  std::copy(c, c + 3, this->CloudCenter);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0); // ascending
+  const double largest = lambda(2);
+  int dim = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    // Standard deviation below ~3e-7 of the largest: flat. (The eigen-solver's absolute accuracy is about
+    // 1e-16 of the largest eigenvalue, so a smaller variance ratio cannot be told from zero.)
+    dim += (largest > 0.0 && lambda(a) > 1e-13 * largest) ? 1 : 0;
+  }
+  this->Frame = LocalFrame();
+  this->Frame.Dimension = dim;
+  int axisAligned = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    axisAligned += this->Points.IsAxisFlat(a) ? 0 : 1;
+  }
+  if (nv > 0 && axisAligned == dim)
+  {
+    // Flat along coordinate axes (or 3D): use the coordinate axes themselves, in order.
+    int row = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (!this->Points.IsAxisFlat(a))
+      {
+        for (int b = 0; b < 3; ++b)
+        {
+          this->Frame.Axes[row][b] = a == b ? 1.0 : 0.0;
+        }
+        ++row;
+      }
+    }
+    for (int a = 0; a < 3 && row < 3; ++a)
+    {
+      if (this->Points.IsAxisFlat(a))
+      {
+        for (int b = 0; b < 3; ++b)
+        {
+          this->Frame.Axes[row][b] = a == b ? 1.0 : 0.0;
+        }
+        ++row;
+      }
+    }
+  }
+  else
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      const Eigen::Vector3d v = eig.eigenvectors().col(2 - a); // largest variance first
+      for (int b = 0; b < 3; ++b)
+      {
+        this->Frame.Axes[a][b] = v(b);
+      }
+    }
+  }
+  this->Rep.CloudDimension = dim;
+  if (!any)
+  {
+    this->Err = "the cloud has no valid point";
+    return false;
+  }
+  return true;
+}
+
+int Approximator::Neighbors(const double x[3], int k, double radius, FitScratch& s, double& h) const
+{
+  if (radius > 0.0)
+  {
+    this->Points.FindWithinRadius(x, radius, s.Ids, &s.Dist2);
+    h = radius;
+    return static_cast<int>(s.Ids.size());
+  }
+  if (s.Ids.size() < static_cast<size_t>(k))
+  {
+    s.Ids.resize(k);
+    s.Dist2.resize(k);
+  }
+  int found = -1;
+  if (s.RadiusGuess > 0.0 && k < this->Points.NumberOfValidPoints())
+  {
+    // Consecutive evaluation points are usually close. The k nearest points of the previous query lie
+    // within d_k(previous) + |x - previous| of x (triangle inequality), so one radius query of that size
+    // holds at least k points, and a selection by (distance, index) gives exactly the k nearest - faster
+    // than the shell search. A far jump makes the ball too big: then the exact k-nearest search is used.
+    const double step = std::sqrt((x[0] - s.LastQuery[0]) * (x[0] - s.LastQuery[0]) +
+      (x[1] - s.LastQuery[1]) * (x[1] - s.LastQuery[1]) + (x[2] - s.LastQuery[2]) * (x[2] - s.LastQuery[2]));
+    double r = s.RadiusGuess + step;
+    if (!(step < s.RadiusGuess))
+    {
+      r = -1.0;
+    }
+    for (int attempt = 0; attempt < 2 && found < 0 && r > 0.0; ++attempt, r *= 1.6)
+    {
+      this->Points.FindWithinRadius(x, r, s.Ids, &s.Dist2);
+      const size_t count = s.Ids.size();
+      if (count < static_cast<size_t>(k))
+      {
+        continue;
+      }
+      s.Candidates.resize(count);
+      for (size_t j = 0; j < count; ++j)
+      {
+        s.Candidates[j] = { s.Dist2[j], s.Ids[j] };
+      }
+      // Afterwards the k-th nearest sits at k - 1 (also when count == k: the farthest goes last) and
+      // the nearer ones before it, unordered.
+      std::nth_element(s.Candidates.begin(), s.Candidates.begin() + (k - 1), s.Candidates.end());
+      for (int j = 0; j < k; ++j)
+      {
+        s.Dist2[j] = s.Candidates[j].first;
+        s.Ids[j] = s.Candidates[j].second;
+      }
+      found = k;
+    }
+    if (found < 0 && s.Ids.size() < static_cast<size_t>(k))
+    {
+      s.Ids.resize(k);
+      s.Dist2.resize(k);
+    }
+  }
+  if (found < 0)
+  {
+    found = this->Points.FindKNearest(x, k, s.Ids.data(), s.Dist2.data());
+  }
+  if (found > 0)
+  {
+    s.RadiusGuess = std::sqrt(s.Dist2[found - 1]);
+    std::copy(x, x + 3, s.LastQuery);
+  }
+  h = found > 0 ? this->Opts.SupportFactor * std::sqrt(s.Dist2[found - 1]) : 0.0;
+  if (!(h > 0.0))
+  {
+    // Every neighbour sits exactly at x: any positive support gives them all the weight W(0).
+    const double diameter = std::sqrt(std::pow(this->Bounds[1] - this->Bounds[0], 2) +
+      std::pow(this->Bounds[3] - this->Bounds[2], 2) + std::pow(this->Bounds[5] - this->Bounds[4], 2));
+    h = diameter > 0.0 ? 1e-9 * diameter : 1.0;
+  }
+  return found;
+}
+
+void Approximator::Mask(const ApproximationOutput& out, Index i) const
+{
+  const int C = this->NumberOfComponents;
+  if (out.Values)
+  {
+    std::fill(out.Values + i * C, out.Values + (i + 1) * C, this->Opts.NullValue);
+  }
+  if (out.Gradients)
+  {
+    std::fill(out.Gradients + 3 * i * C, out.Gradients + 3 * (i + 1) * C, 0.0);
+  }
+  if (out.Valid)
+  {
+    out.Valid[i] = 0;
+  }
+  if (out.NeighborCounts)
+  {
+    out.NeighborCounts[i] = 0.0;
+  }
+  if (out.Conditions)
+  {
+    out.Conditions[i] = 0.0;
+  }
+}
+
+int Approximator::MLSShape(const double x[3], FitScratch& s, bool gradient, bool exact, double& h,
+  PointResult& result) const
+{
+  result = PointResult{ false, 0, 0.0, false, false };
+  const int D = this->Frame.Dimension;
+  int k = this->Opts.NeighborCount;
+  double radius = this->Opts.SupportRadius;
+  const double* coords = this->Coordinates.data();
+  for (int attempt = 0; attempt < 2; ++attempt)
+  {
+    const int n = this->Neighbors(x, k, radius, s, h);
+    s.Reserve(static_cast<size_t>(std::max(n, 1)));
+    const double invH = 1.0 / h;
+    const double invH2 = invH * invH;
+    int m = 0;
+    for (int j = 0; j < n; ++j)
+    {
+      const double w = this->UnitKernel.ValueSquared(s.Dist2[j] * invH2);
+      if (!(w > 0.0) || !std::isfinite(w))
+      {
+        continue;
+      }
+      const Index id = s.Ids[j];
+      const double dx[3] = { coords[3 * id] - x[0], coords[3 * id + 1] - x[1], coords[3 * id + 2] - x[2] };
+      double* xi = &s.Xi[3 * m];
+      for (int a = 0; a < 3; ++a)
+      {
+        xi[a] = a < D ? (this->Frame.Axes[a][0] * dx[0] + this->Frame.Axes[a][1] * dx[1] +
+                          this->Frame.Axes[a][2] * dx[2]) *
+            invH
+                      : 0.0;
+      }
+      if (gradient)
+      {
+        // d w / d xi_eval = grad W at r = x - x_j = -xi (the unit kernel has h = 1).
+        const double r[3] = { -xi[0], -xi[1], -xi[2] };
+        this->UnitKernel.Gradient(r, &s.WeightDerivatives[3 * m]);
+      }
+      s.Ids[m] = id;
+      s.Weights[m] = w;
+      ++m;
+    }
+    if (m > 0)
+    {
+      const int lowest = attempt == 0 ? this->Opts.Degree : 0;
+      for (int degree = this->Opts.Degree; degree >= lowest; --degree)
+      {
+        double condition = 0.0;
+        if (ComputeMLSShapeFunctions(D, degree, s.Xi.data(), s.Weights.data(), s.WeightDerivatives.data(), m,
+              gradient, exact, s.Rows.data(), s.Phi.data(), s.DPhi.data(), condition))
+        {
+          result.Valid = true;
+          result.Neighbors = m;
+          result.Condition = condition;
+          result.Widened = attempt > 0;
+          result.Lowered = degree < this->Opts.Degree;
+          return m;
+        }
+      }
+    }
+    // Widen the support: twice the neighbours, or twice the radius.
+    k = 2 * k;
+    radius = 2.0 * radius;
+  }
+  return 0;
+}
+
+Approximator::PointResult Approximator::MLSPoint(
+  const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const
+{
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const bool gradient = out.Gradients != nullptr;
+  PointResult result;
+  double h = 1.0;
+  const int m = this->MLSShape(x, s, gradient, out.Conditions != nullptr, h, result);
+  if (m <= 0)
+  {
+    return result;
+  }
+  // Apply the shape functions to every component (one pass over the neighbours).
+  bool finite = true;
+  if (out.Values)
+  {
+    double* v = out.Values + i * C;
+    std::fill(v, v + C, 0.0);
+    for (int j = 0; j < m; ++j)
+    {
+      const double* f = &this->Values[static_cast<size_t>(s.Ids[j]) * C];
+      const double phi = s.Phi[j];
+      for (int c = 0; c < C; ++c)
+      {
+        v[c] += phi * f[c];
+      }
+    }
+    for (int c = 0; c < C; ++c)
+    {
+      finite = finite && std::isfinite(v[c]);
+    }
+  }
+  if (gradient)
+  {
+    const double invH = 1.0 / h;
+    double* g = out.Gradients + 3 * i * C;
+    for (int c = 0; c < C; ++c)
+    {
+      double local[3] = { 0, 0, 0 };
+      for (int a = 0; a < D; ++a)
+      {
+        const double* dphi = &s.DPhi[static_cast<size_t>(a) * m];
+        double sum = 0.0;
+        for (int j = 0; j < m; ++j)
+        {
+          sum += dphi[j] * this->Values[static_cast<size_t>(s.Ids[j]) * C + c];
+        }
+        local[a] = sum * invH;
+      }
+      this->Frame.Unproject(local, g + 3 * c);
+      finite = finite && std::isfinite(g[3 * c]) && std::isfinite(g[3 * c + 1]) && std::isfinite(g[3 * c + 2]);
+    }
+  }
+  result.Valid = result.Valid && finite;
+  return result;
+}
+
+bool Approximator::ShapeFunctions(
+  const double x[3], std::vector<Index>& ids, std::vector<double>& phi, FitScratch& scratch) const
+{
+  ids.clear();
+  phi.clear();
+  if (this->Points.NumberOfValidPoints() == 0 || !std::isfinite(x[0]) || !std::isfinite(x[1]) ||
+    !std::isfinite(x[2]))
+  {
+    return false;
+  }
+  PointResult result;
+  double h = 1.0;
+  const int m = this->MLSShape(x, scratch, false, false, h, result);
+  for (int j = 0; j < m; ++j)
+  {
+    if (!std::isfinite(scratch.Phi[j]))
+    {
+      ids.clear();
+      phi.clear();
+      return false;
+    }
+    ids.push_back(scratch.Ids[j]);
+    phi.push_back(scratch.Phi[j]);
+  }
+  return m > 0;
+}
+
+} // namespace meshfree

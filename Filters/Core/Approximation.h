@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class meshfree::Approximator
+ * @brief LS, WLS, MLS, PU-WLS and SPH approximation of scattered data (thesis ch. 2-3), VTK-free.
+ *
+ * SetCloud() takes the points and their values (C components per point, row-major, all arrays of a data
+ * set side by side), Evaluate() approximates every component at a set of evaluation points in one pass: the
+ * shape functions depend only on the geometry, so they are computed once per evaluation point and applied
+ * to all C components.
+ *
+ * Methods (thesis equation numbers):
+ * - LS (3.1-3.7): one global unweighted fit, in coordinates shifted to the cloud's centroid and scaled by
+ *   its largest distance from it.
+ * - WLS (3.8-3.15): one fit around Options.Center, weights theta(|x_i - Center|), support from the
+ *   NeighborCount nearest points of the centre (or SupportRadius). Valid near the centre only.
+ * - MLS (3.22-3.29, 2.9-2.24): the WLS fit re-centred at every evaluation point (shape functions, see
+ *   LocalFit.h). Gradients are diffuse derivatives (exact for polynomials of degree <= m; for degree 0 the
+ *   true derivative of Shepard's formula at fixed h).
+ * - PU-WLS (3.16-3.21): WLS fits at centres blended by the partition of unity
+ *   phi_c(x) = theta_c(x) / sum_k theta_k(x). Centres: the nodes of a regular lattice in the cloud's
+ *   intrinsic frame whose spacing s makes the cover ball of radius R = s sqrt(d) hold about NeighborCount
+ *   points; a node is kept when its fit (over the points within max(1.1 R, 1.1 d_k)) succeeds. R > s sqrt(d)/2
+ *   makes every point of the lattice's box covered, by about 2^d centres. Gradients are the true derivative.
+ * - SPH (2.3, 5.10): A(x) = sum_j A_j V_j W(|x - x_j|, h) with V_j = m_j / rho_j when volumes are given
+ *   (Mass and Density arrays) and otherwise V_j = 1 / sum_k W(|x_j - x_k|, h_j) (the inverse number
+ *   density); optional Shepard normalisation divides by sum_j V_j W. The kernel is normalised in the
+ *   cloud's dimension.
+ *
+ * Support radius: with SupportRadius <= 0, h = SupportFactor * (distance to the NeighborCount-th nearest
+ * point) at each evaluation point, so that exactly NeighborCount points carry weight (SupportFactor = 1.1);
+ * SupportRadius > 0 fixes h.
+ *
+ * Dimension: the cloud's intrinsic dimension (0..3) comes from a PCA of the valid points (axes with a
+ * standard deviation below 3e-7 of the largest are flat); the basis uses the intrinsic axes (the coordinate
+ * axes when the cloud is flat along coordinate axes), distances are always 3D.
+ *
+ * Fallback chain for a degenerate fit (kappa > kMaxCondition, see LocalFit.h): widen the support (twice the
+ * neighbours, or twice the radius) -> lower the degree one by one -> degree 0 (Shepard) -> mask (value
+ * NullValue, Valid = 0). Non-finite results are masked as well: no NaN or Inf leaves Evaluate().
+ * Points with NaN/Inf coordinates or values are excluded from the cloud (and counted).
+ */
+#ifndef meshfree_Approximation_h
+#define meshfree_Approximation_h
+
+#include "Kernels.h"
+#include "LocalFit.h"
+#include "NeighborGrid.h"
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace meshfree
+{
+
+enum class ApproximationMethod
+{
+  LS = 0,
+  WLS = 1,
+  MLS = 2,
+  PUWLS = 3,
+  SPH = 4
+};
+
+/// "LS", "WLS", "MLS", "PU-WLS", "SPH".
+const char* ApproximationMethodName(ApproximationMethod method);
+bool ApproximationMethodFromName(const std::string& name, ApproximationMethod& out);
+
+struct ApproximationOptions
+{
+  ApproximationMethod Method = ApproximationMethod::MLS;
+  int Degree = 2; // 0..3
+  KernelType Weight = KernelType::Wendland;
+  int NeighborCount = 20;
+  double SupportRadius = 0.0; // > 0: fixed support radius
+  double SupportFactor = 1.1; // h = SupportFactor * d_k
+  double Epsilon = 1e-3;      // InverseDistance, relative to h
+  bool CenterSet = false;     // WLS centre; false: centre of the cloud's bounds
+  double Center[3] = { 0.0, 0.0, 0.0 };
+  bool ShepardNormalization = true; // SPH
+  bool ComputeGradients = false;
+  bool Diagnostics = false;
+  double NullValue = 0.0;
+};
+
+/// Where the results go (m evaluation points, C components). Null pointers switch outputs off.
+struct ApproximationOutput
+{
+  double* Values = nullptr;        // m * C
+  double* Gradients = nullptr;     // m * C * 3 (d/dx, d/dy, d/dz per component)
+  unsigned char* Valid = nullptr;  // m
+  double* NeighborCounts = nullptr; // m: points with a nonzero weight in the fit that was used
+  double* Conditions = nullptr;    // m: condition number of the equilibrated moment matrix (1 for SPH)
+};
+
+/// What happened during the last SetCloud()/Evaluate().
+struct ApproximationReport
+{
+  Index CloudPoints = 0;     // points given
+  Index ExcludedPoints = 0;  // NaN/Inf coordinates or values, non-positive volumes
+  int CloudDimension = 0;
+  Index Evaluated = 0;
+  Index Masked = 0;          // no support or degenerate after every fallback
+  Index Widened = 0;         // needed a wider support
+  Index DegreeLowered = 0;   // needed a lower degree (degree 0 included)
+  Index Centers = 0;         // PU-WLS centres kept
+  int DegreeUsed = 0;        // LS/WLS: degree of the global fit
+  bool Aborted = false;
+};
+
+/// Called between blocks of evaluation points with the fraction done; return false to abort.
+using ProgressCallback = std::function<bool(double)>;
+
+class Approximator
+{
+public:
+  Approximator();
+  ~Approximator();
+  Approximator(const Approximator&) = delete;
+  Approximator& operator=(const Approximator&) = delete;
+
+  /// Returns false (Error()) for invalid options: degree outside 0..3, NeighborCount < 1, bad epsilon.
+  bool SetOptions(const ApproximationOptions& options);
+  const ApproximationOptions& Options() const { return this->Opts; }
+
+  /// The cloud: n points (x, y, z interleaved), values (n * components, row-major; may be null when
+  /// components == 0) and, for SPH, optional volumes V_j = m_j / rho_j. The data are copied.
+  /// Returns false (Error()) when no point is valid; Evaluate() then masks everything.
+  bool SetCloud(const double* xyz, Index n, const double* values, int components,
+    const double* volumes = nullptr);
+
+  /// Approximates at m points (x, y, z interleaved). Returns false when aborted or nothing could be done;
+  /// every output is defined in any case (masked points get NullValue and Valid = 0).
+  bool Evaluate(const double* xyz, Index m, const ApproximationOutput& out,
+    const ProgressCallback& progress = ProgressCallback());
+
+  const ApproximationReport& Report() const { return this->Rep; }
+  const std::string& Error() const { return this->Err; }
+  int Components() const { return this->NumberOfComponents; }
+  int CloudDimension() const { return this->Frame.Dimension; }
+  const LocalFrame& Frame3() const { return this->Frame; }
+  const NeighborGrid& Grid() const { return this->Points; }
+
+  /// MLS shape functions at one point (for the VTK interpolation kernel): the ids and phi of the points
+  /// carrying weight. Returns false when the point is masked. Thread-safe after SetCloud() and
+  /// PrepareShapeFunctions().
+  bool PrepareShapeFunctions();
+  bool ShapeFunctions(const double x[3], std::vector<Index>& ids, std::vector<double>& phi,
+    FitScratch& scratch) const;
+  /// MLS shape functions at x over the caller's neighbours ids[0..n) (phi[j] for ids[j]; support
+  /// SupportRadius or 1.1 x the farthest of them; degenerate: lower degrees down to Shepard). Returns
+  /// false (phi all 0) when no fit exists. Thread-safe after SetCloud() and PrepareShapeFunctions().
+  bool ShapeFunctionsFor(const double x[3], const Index* ids, int n, std::vector<double>& phi,
+    FitScratch& scratch) const;
+
+private:
+  struct PUData;
+  struct PointResult
+  {
+    bool Valid;
+    int Neighbors;
+    double Condition;
+    bool Widened;
+    bool Lowered;
+  };
+
+  bool PrepareGlobalFit();
+  bool PreparePU();
+  bool PrepareSPHVolumes();
+  int MLSShape(const double x[3], FitScratch& s, bool gradient, bool exact, double& h,
+    PointResult& result) const;
+  PointResult MLSPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
+  PointResult SPHPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
+  PointResult PUPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
+  PointResult GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const;
+  int Neighbors(const double x[3], int k, double radius, FitScratch& s, double& h) const;
+  void Mask(const ApproximationOutput& out, Index i) const;
+
+  ApproximationOptions Opts;
+  ApproximationReport Rep;
+  std::string Err;
+  NeighborGrid Points;
+  LocalFrame Frame;
+  Kernel UnitKernel; // support 1: weights from q = r / h
+  std::vector<double> Coordinates;
+  std::vector<double> Values;
+  std::vector<double> Volumes;    // given V_j = m_j / rho_j (SPH)
+  std::vector<double> SphVolumes; // the volumes SPH uses (given or estimated)
+  int NumberOfComponents = 0;
+  double Bounds[6] = { 0, 0, 0, 0, 0, 0 };
+  double CloudCenter[3] = { 0, 0, 0 };
+  // LS / WLS: one global fit.
+  std::vector<double> GlobalCoefficients;
+  double GlobalOrigin[3] = { 0, 0, 0 };
+  double GlobalInvScale = 1.0;
+  int GlobalDegree = -1;
+  int GlobalNeighbors = 0;
+  double GlobalCondition = 0.0;
+  std::unique_ptr<PUData> PU;
+};
+
+} // namespace meshfree
+
+#endif

@@ -1,0 +1,367 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Approximator: the parallel evaluation loop (blocks for progress and abort, per-thread scratch) and the
+// global fits of LS (3.1-3.7) and WLS (3.8-3.15).
+#include "Approximation.h"
+#include "ApproximationPU.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace meshfree
+{
+
+bool Approximator::PrepareShapeFunctions()
+{
+  try
+  {
+    this->UnitKernel =
+      Kernel(this->Opts.Weight, std::max(1, this->Frame.Dimension), 1.0, this->Opts.Epsilon);
+  }
+  catch (const std::exception& e)
+  {
+    this->Err = e.what();
+    return false;
+  }
+  return this->Points.NumberOfValidPoints() > 0;
+}
+
+bool Approximator::PrepareGlobalFit()
+{
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const Index nv = this->Points.NumberOfValidPoints();
+  const double* sp = this->Points.SortedPoints();
+  const Index* order = this->Points.SortedOrder().data();
+  this->GlobalCoefficients.assign(static_cast<size_t>(kMaxBasisSize) * C, 0.0);
+  this->GlobalDegree = -1;
+  if (this->Opts.Method == ApproximationMethod::LS)
+  {
+    // Shift to the centroid, scale by the largest distance from it (3.19-3.20).
+    std::copy(this->CloudCenter, this->CloudCenter + 3, this->GlobalOrigin);
+    double largest2 = 0.0;
+    for (Index i = 0; i < nv; ++i)
+    {
+      double d2 = 0.0;
+      for (int a = 0; a < 3; ++a)
+      {
+        d2 += (sp[3 * i + a] - this->GlobalOrigin[a]) * (sp[3 * i + a] - this->GlobalOrigin[a]);
+      }
+      largest2 = std::max(largest2, d2);
+    }
+    const double scale = largest2 > 0.0 ? std::sqrt(largest2) : 1.0;
+    this->GlobalInvScale = 1.0 / scale;
+    for (int degree = this->Opts.Degree; degree >= 0; --degree)
+    {
+      const int q = BasisSize(D, D > 0 ? degree : 0);
+      std::vector<double> moment(static_cast<size_t>(q) * q, 0.0);
+      std::vector<double> rhs(static_cast<size_t>(q) * C, 0.0);
+#pragma omp parallel if (nv > 65536)
+      {
+        std::vector<double> m(moment.size(), 0.0), r(rhs.size(), 0.0);
+        constexpr Index block = 256;
+        double xi[3 * block];
+#pragma omp for schedule(static)
+        for (Index b = 0; b < nv; b += block)
+        {
+          const Index e = std::min(nv, b + block);
+          for (Index i = b; i < e; ++i)
+          {
+            const double dx[3] = { sp[3 * i] - this->GlobalOrigin[0], sp[3 * i + 1] - this->GlobalOrigin[1],
+              sp[3 * i + 2] - this->GlobalOrigin[2] };
+            double* x = xi + 3 * (i - b);
+            x[0] = x[1] = x[2] = 0.0;
+            this->Frame.Project<3>(dx, this->GlobalInvScale, x);
+          }
+          AccumulateFit(D, degree, xi, nullptr, static_cast<int>(e - b), order + b, this->Values.data(), C,
+            m.data(), r.data());
+        }
+#pragma omp critical
+        {
+          for (size_t a = 0; a < m.size(); ++a)
+          {
+            moment[a] += m[a];
+          }
+          for (size_t a = 0; a < r.size(); ++a)
+          {
+            rhs[a] += r[a];
+          }
+        }
+      }
+      if (nv >= q &&
+        SolveAccumulatedFit(D, degree, moment.data(), rhs.data(), C, this->Opts.Diagnostics,
+          this->GlobalCoefficients.data(), this->GlobalCondition))
+      {
+        this->GlobalDegree = degree;
+        this->GlobalNeighbors = static_cast<int>(std::min<Index>(nv, 2147483647));
+        break;
+      }
+    }
+    this->Rep.DegreeUsed = this->GlobalDegree;
+    return this->GlobalDegree >= 0;
+  }
+
+  // WLS: one fit around the centre, with the MLS support rule and fallback chain.
+  double center[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    center[a] = this->Opts.CenterSet ? this->Opts.Center[a]
+                                     : 0.5 * (this->Bounds[2 * a] + this->Bounds[2 * a + 1]);
+    if (!std::isfinite(center[a]))
+    {
+      this->Err = "the WLS centre is not finite";
+      return false;
+    }
+  }
+  std::copy(center, center + 3, this->GlobalOrigin);
+  FitScratch s;
+  int k = this->Opts.NeighborCount;
+  double radius = this->Opts.SupportRadius;
+  for (int attempt = 0; attempt < 2 && this->GlobalDegree < 0; ++attempt)
+  {
+    double h = 1.0;
+    const int n = this->Neighbors(center, k, radius, s, h);
+    s.Reserve(static_cast<size_t>(std::max(n, 1)));
+    this->GlobalInvScale = 1.0 / h;
+    int m = 0;
+    for (int j = 0; j < n; ++j)
+    {
+      const double w = this->UnitKernel.ValueSquared(s.Dist2[j] / (h * h));
+      if (!(w > 0.0) || !std::isfinite(w))
+      {
+        continue;
+      }
+      const Index id = s.Ids[j];
+      const double dx[3] = { this->Coordinates[3 * id] - center[0], this->Coordinates[3 * id + 1] - center[1],
+        this->Coordinates[3 * id + 2] - center[2] };
+      double* xi = &s.Xi[3 * m];
+      xi[0] = xi[1] = xi[2] = 0.0;
+      this->Frame.Project<3>(dx, this->GlobalInvScale, xi);
+      for (int a = D; a < 3; ++a)
+      {
+        xi[a] = 0.0;
+      }
+      s.Ids[m] = id;
+      s.Weights[m] = w;
+      ++m;
+    }
+    const int lowest = attempt == 0 ? this->Opts.Degree : 0;
+    for (int degree = this->Opts.Degree; m > 0 && degree >= lowest; --degree)
+    {
+      if (ComputeFitCoefficients(D, degree, s.Xi.data(), s.Weights.data(), m, s.Ids.data(),
+            this->Values.data(), C, this->Opts.Diagnostics, this->GlobalCoefficients.data(),
+            this->GlobalCondition))
+      {
+        this->GlobalDegree = degree;
+        this->GlobalNeighbors = m;
+        break;
+      }
+    }
+    k *= 2;
+    radius *= 2.0;
+  }
+  this->Rep.DegreeUsed = this->GlobalDegree;
+  if (this->GlobalDegree < 0)
+  {
+    this->Err = "the WLS fit around the centre is degenerate even after the fallbacks";
+  }
+  return this->GlobalDegree >= 0;
+}
+
+Approximator::PointResult Approximator::GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const
+{
+  PointResult result{ true, this->GlobalNeighbors, this->GlobalCondition, false,
+    this->GlobalDegree < this->Opts.Degree };
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const double dx[3] = { x[0] - this->GlobalOrigin[0], x[1] - this->GlobalOrigin[1], x[2] - this->GlobalOrigin[2] };
+  double xi[3] = { 0, 0, 0 };
+  this->Frame.Project<3>(dx, this->GlobalInvScale, xi);
+  double local[3 * 64];
+  std::vector<double> heapLocal;
+  double* grad = nullptr;
+  if (out.Gradients)
+  {
+    grad = local;
+    if (3 * C > 3 * 64)
+    {
+      heapLocal.resize(3 * static_cast<size_t>(C));
+      grad = heapLocal.data();
+    }
+  }
+  std::vector<double> scratchValues;
+  double* values = out.Values ? out.Values + i * C : nullptr;
+  if (!values && C > 0)
+  {
+    scratchValues.resize(C);
+    values = scratchValues.data();
+  }
+  EvaluateFit(D, this->GlobalDegree, xi, this->GlobalCoefficients.data(), C, values, grad);
+  bool finite = true;
+  for (int c = 0; c < C; ++c)
+  {
+    finite = finite && std::isfinite(values[c]);
+    if (grad)
+    {
+      double l[3] = { 0, 0, 0 };
+      for (int a = 0; a < D; ++a)
+      {
+        l[a] = grad[a * C + c] * this->GlobalInvScale;
+      }
+      double* g = out.Gradients + 3 * (i * C + c);
+      this->Frame.Unproject(l, g);
+      finite = finite && std::isfinite(g[0]) && std::isfinite(g[1]) && std::isfinite(g[2]);
+    }
+  }
+  result.Valid = finite;
+  return result;
+}
+
+bool Approximator::Evaluate(
+  const double* xyz, Index m, const ApproximationOutput& out, const ProgressCallback& progress)
+{
+  this->Rep.Evaluated = std::max<Index>(m, 0);
+  this->Rep.Masked = this->Rep.Widened = this->Rep.DegreeLowered = 0;
+  this->Rep.Aborted = false;
+  this->Rep.Centers = 0;
+  this->Rep.DegreeUsed = -1;
+  this->Err.clear();
+  if (m <= 0)
+  {
+    return true;
+  }
+  auto maskFrom = [&](Index begin) {
+    for (Index i = begin; i < m; ++i)
+    {
+      this->Mask(out, i);
+    }
+    this->Rep.Masked += m - begin;
+  };
+  if (!this->PrepareShapeFunctions())
+  {
+    if (this->Err.empty())
+    {
+      this->Err = "the cloud has no valid point";
+    }
+    maskFrom(0);
+    return false;
+  }
+  bool ready = true;
+  switch (this->Opts.Method)
+  {
+    case ApproximationMethod::LS:
+    case ApproximationMethod::WLS:
+      ready = this->PrepareGlobalFit();
+      break;
+    case ApproximationMethod::PUWLS:
+      ready = this->PreparePU();
+      break;
+    case ApproximationMethod::SPH:
+      ready = this->PrepareSPHVolumes();
+      break;
+    case ApproximationMethod::MLS:
+      break;
+  }
+  if (!ready)
+  {
+    if (this->Err.empty())
+    {
+      this->Err = "the fit could not be prepared";
+    }
+    maskFrom(0);
+    return false;
+  }
+#ifdef _OPENMP
+  const int threads = omp_get_max_threads();
+#else
+  const int threads = 1;
+#endif
+  std::vector<FitScratch> scratch(static_cast<size_t>(threads));
+  const Index blockSize = 16384;
+  Index masked = 0, widened = 0, lowered = 0;
+  for (Index begin = 0; begin < m; begin += blockSize)
+  {
+    if (progress && !progress(static_cast<double>(begin) / static_cast<double>(m)))
+    {
+      this->Rep.Aborted = true;
+      maskFrom(begin);
+      this->Rep.Masked += masked;
+      this->Rep.Widened += widened;
+      this->Rep.DegreeLowered += lowered;
+      this->Err = "aborted";
+      return false;
+    }
+    const Index end = std::min(m, begin + blockSize);
+    // A global fit is cheap to evaluate: threads would cost more than they save on small blocks.
+    const bool global =
+      this->Opts.Method == ApproximationMethod::LS || this->Opts.Method == ApproximationMethod::WLS;
+    const bool parallel = (end - begin) >= (global ? 8192 : 256);
+#pragma omp parallel if (parallel) reduction(+ : masked, widened, lowered)
+    {
+#ifdef _OPENMP
+      FitScratch& s = scratch[static_cast<size_t>(omp_get_thread_num())];
+#else
+      FitScratch& s = scratch[0];
+#endif
+#pragma omp for schedule(dynamic, 64)
+      for (Index i = begin; i < end; ++i)
+      {
+        const double* x = xyz + 3 * i;
+        PointResult r{ false, 0, 0.0, false, false };
+        if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
+        {
+          switch (this->Opts.Method)
+          {
+            case ApproximationMethod::LS:
+            case ApproximationMethod::WLS:
+              r = this->GlobalPoint(x, out, i);
+              break;
+            case ApproximationMethod::MLS:
+              r = this->MLSPoint(x, s, out, i);
+              break;
+            case ApproximationMethod::PUWLS:
+              r = this->PUPoint(x, s, out, i);
+              break;
+            case ApproximationMethod::SPH:
+              r = this->SPHPoint(x, s, out, i);
+              break;
+          }
+        }
+        if (!r.Valid)
+        {
+          this->Mask(out, i);
+          ++masked;
+          continue;
+        }
+        widened += r.Widened ? 1 : 0;
+        lowered += r.Lowered ? 1 : 0;
+        if (out.Valid)
+        {
+          out.Valid[i] = 1;
+        }
+        if (out.NeighborCounts)
+        {
+          out.NeighborCounts[i] = r.Neighbors;
+        }
+        if (out.Conditions)
+        {
+          out.Conditions[i] = std::isfinite(r.Condition) ? r.Condition : 0.0;
+        }
+      }
+    }
+  }
+  if (progress)
+  {
+    progress(1.0);
+  }
+  this->Rep.Masked += masked;
+  this->Rep.Widened += widened;
+  this->Rep.DegreeLowered += lowered;
+  return true;
+}
+
+} // namespace meshfree

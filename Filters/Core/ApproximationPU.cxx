@@ -1,0 +1,285 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// PU-WLS (thesis 3.16-3.21): local WLS fits at lattice centres blended by a partition of unity. The choice
+// of the centres is documented in Approximation.h.
+#include "ApproximationPU.h"
+
+#include <algorithm>
+#include <cmath>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace meshfree
+{
+
+bool Approximator::PreparePU()
+{
+  this->PU.reset(new PUData);
+  PUData& pu = *this->PU;
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const Index nv = this->Points.NumberOfValidPoints();
+  const double* sp = this->Points.SortedPoints();
+  const int k = this->Opts.NeighborCount;
+  constexpr double pi = 3.141592653589793238462643383279502884;
+
+  double umin[3] = { 0, 0, 0 }, umax[3] = { 0, 0, 0 };
+  for (int a = 0; a < D; ++a)
+  {
+    umin[a] = std::numeric_limits<double>::infinity();
+    umax[a] = -umin[a];
+  }
+  for (Index i = 0; i < nv; ++i)
+  {
+    const double dx[3] = { sp[3 * i] - this->CloudCenter[0], sp[3 * i + 1] - this->CloudCenter[1],
+      sp[3 * i + 2] - this->CloudCenter[2] };
+    double u[3];
+    this->Frame.Project<3>(dx, 1.0, u);
+    for (int a = 0; a < D; ++a)
+    {
+      umin[a] = std::min(umin[a], u[a]);
+      umax[a] = std::max(umax[a], u[a]);
+    }
+  }
+  double spacing = 1.0;
+  double cover = 1.0;
+  Index counts[3] = { 1, 1, 1 };
+  if (D > 0)
+  {
+    if (this->Opts.SupportRadius > 0.0)
+    {
+      cover = this->Opts.SupportRadius / this->Opts.SupportFactor;
+      spacing = cover / std::sqrt(static_cast<double>(D));
+    }
+    else
+    {
+      double volume = 1.0;
+      for (int a = 0; a < D; ++a)
+      {
+        volume *= umax[a] - umin[a];
+      }
+      const double omega = D == 1 ? 2.0 : (D == 2 ? pi : 4.0 * pi / 3.0);
+      const double density = static_cast<double>(nv) / volume;
+      // The cover ball of radius R = s sqrt(d) holds about NeighborCount points.
+      spacing = std::pow(k / (density * omega * std::pow(static_cast<double>(D), 0.5 * D)), 1.0 / D);
+      cover = spacing * std::sqrt(static_cast<double>(D));
+    }
+    for (;;)
+    {
+      double total = 1.0;
+      for (int a = 0; a < D; ++a)
+      {
+        counts[a] = static_cast<Index>(std::ceil((umax[a] - umin[a]) / spacing)) + 1;
+        total *= static_cast<double>(counts[a]);
+      }
+      if (total <= 4.0 * static_cast<double>(nv) + 64.0 && std::isfinite(total))
+      {
+        break;
+      }
+      spacing *= 1.25;
+      cover = spacing * std::sqrt(static_cast<double>(D));
+    }
+  }
+  pu.CoverRadius = cover;
+  const Index nodes = counts[0] * counts[1] * counts[2];
+  const size_t stride = static_cast<size_t>(kMaxBasisSize) * C;
+  std::vector<double> centers(3 * nodes), supports(nodes), conditions(nodes), coefficients(stride * nodes);
+  std::vector<int> degrees(nodes, -1), fitCounts(nodes, 0);
+
+#pragma omp parallel
+  {
+    FitScratch s;
+#pragma omp for schedule(dynamic, 16)
+    for (Index node = 0; node < nodes; ++node)
+    {
+      const Index index[3] = { node % counts[0], (node / counts[0]) % counts[1], node / (counts[0] * counts[1]) };
+      double x[3] = { this->CloudCenter[0], this->CloudCenter[1], this->CloudCenter[2] };
+      for (int a = 0; a < D; ++a)
+      {
+        const double u = umin[a] + static_cast<double>(index[a]) * spacing;
+        for (int b = 0; b < 3; ++b)
+        {
+          x[b] += u * this->Frame.Axes[a][b];
+        }
+      }
+      std::copy(x, x + 3, &centers[3 * node]);
+      double h = 0.0;
+      if (this->Opts.SupportRadius > 0.0)
+      {
+        h = this->Opts.SupportRadius;
+      }
+      else
+      {
+        this->Neighbors(x, k, 0.0, s, h);
+        h = std::max(h, this->Opts.SupportFactor * cover);
+      }
+      for (int attempt = 0; attempt < 2 && degrees[node] < 0; ++attempt, h *= 2.0)
+      {
+        this->Points.FindWithinRadius(x, h, s.Ids, &s.Dist2);
+        const int n = static_cast<int>(s.Ids.size());
+        if (attempt == 0)
+        {
+          // A centre with no data inside its cover region blends nothing: drop it.
+          const bool covered = std::any_of(s.Dist2.begin(), s.Dist2.end(), [&](double d2) { return d2 < cover * cover; });
+          if (!covered)
+          {
+            break;
+          }
+        }
+        s.Reserve(static_cast<size_t>(std::max(n, 1)));
+        int m = 0;
+        for (int j = 0; j < n; ++j)
+        {
+          const double w = this->UnitKernel.ValueSquared(s.Dist2[j] / (h * h));
+          if (!(w > 0.0) || !std::isfinite(w))
+          {
+            continue;
+          }
+          const Index id = s.Ids[j];
+          const double dx[3] = { this->Coordinates[3 * id] - x[0], this->Coordinates[3 * id + 1] - x[1],
+            this->Coordinates[3 * id + 2] - x[2] };
+          double* xi = &s.Xi[3 * m];
+          this->Frame.Project<3>(dx, 1.0 / h, xi);
+          s.Ids[m] = id;
+          s.Weights[m] = w;
+          ++m;
+        }
+        const int lowest = attempt == 0 ? this->Opts.Degree : 0;
+        for (int degree = this->Opts.Degree; m > 0 && degree >= lowest; --degree)
+        {
+          if (ComputeFitCoefficients(D, degree, s.Xi.data(), s.Weights.data(), m, s.Ids.data(),
+                this->Values.data(), C, this->Opts.Diagnostics, &coefficients[stride * node], conditions[node]))
+          {
+            degrees[node] = degree;
+            fitCounts[node] = m;
+            supports[node] = h;
+            break;
+          }
+        }
+      }
+    }
+  }
+  Index kept = 0;
+  for (Index node = 0; node < nodes; ++node)
+  {
+    if (degrees[node] < 0)
+    {
+      continue;
+    }
+    pu.Centers.insert(pu.Centers.end(), &centers[3 * node], &centers[3 * node] + 3);
+    pu.Supports.push_back(supports[node]);
+    pu.Degrees.push_back(degrees[node]);
+    pu.Counts.push_back(fitCounts[node]);
+    pu.Conditions.push_back(conditions[node]);
+    pu.Coefficients.insert(
+      pu.Coefficients.end(), coefficients.begin() + stride * node, coefficients.begin() + stride * (node + 1));
+    ++kept;
+  }
+  this->Rep.Centers = kept;
+  if (kept == 0)
+  {
+    this->Err = "no PU-WLS centre has a valid fit";
+    return false;
+  }
+  pu.CenterGrid.Build(pu.Centers.data(), kept);
+  return true;
+}
+
+Approximator::PointResult Approximator::PUPoint(
+  const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const
+{
+  PointResult result{ false, 0, 0.0, false, false };
+  const PUData& pu = *this->PU;
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const bool gradient = out.Gradients != nullptr;
+  const size_t stride = static_cast<size_t>(kMaxBasisSize) * C;
+  const double R = pu.CoverRadius;
+  pu.CenterGrid.FindWithinRadius(x, R, s.Ids, &s.Dist2);
+  // Work: blended values (C), blended local gradients (3C), one centre's values (C) and gradients (3C).
+  s.Work.resize(8 * static_cast<size_t>(C) + 8);
+  double* sumValues = s.Work.data();
+  double* sumGrad = sumValues + C;
+  double* local = sumGrad + 3 * C;
+  double* localGrad = local + C;
+  std::fill(sumValues, sumValues + 4 * C, 0.0);
+  double sumTheta = 0.0;
+  double sumDTheta[3] = { 0, 0, 0 };
+  double best = 0.0;
+  for (size_t j = 0; j < s.Ids.size(); ++j)
+  {
+    const double theta = this->UnitKernel.ValueSquared(s.Dist2[j] / (R * R));
+    if (!(theta > 0.0))
+    {
+      continue;
+    }
+    const Index c = s.Ids[j];
+    const double* xc = &pu.Centers[3 * c];
+    const double dx[3] = { x[0] - xc[0], x[1] - xc[1], x[2] - xc[2] };
+    double xi[3] = { 0, 0, 0 };
+    this->Frame.Project<3>(dx, 1.0 / pu.Supports[c], xi);
+    EvaluateFit(D, pu.Degrees[c], xi, &pu.Coefficients[stride * c], C, local, gradient ? localGrad : nullptr);
+    sumTheta += theta;
+    for (int q = 0; q < C; ++q)
+    {
+      sumValues[q] += theta * local[q];
+    }
+    if (gradient)
+    {
+      double r[3] = { 0, 0, 0 }, dTheta[3];
+      this->Frame.Project<3>(dx, 1.0 / R, r);
+      for (int a = D; a < 3; ++a)
+      {
+        r[a] = 0.0;
+      }
+      this->UnitKernel.Gradient(r, dTheta); // per unit r / R
+      for (int a = 0; a < D; ++a)
+      {
+        dTheta[a] /= R;
+        sumDTheta[a] += dTheta[a];
+        for (int q = 0; q < C; ++q)
+        {
+          sumGrad[a * C + q] += dTheta[a] * local[q] + theta * localGrad[a * C + q] / pu.Supports[c];
+        }
+      }
+    }
+    if (theta > best)
+    {
+      best = theta;
+      result.Neighbors = pu.Counts[c];
+      result.Condition = pu.Conditions[c];
+      result.Lowered = pu.Degrees[c] < this->Opts.Degree;
+    }
+  }
+  if (!(sumTheta > 0.0))
+  {
+    return result;
+  }
+  bool finite = true;
+  for (int q = 0; q < C; ++q)
+  {
+    const double f = sumValues[q] / sumTheta;
+    finite = finite && std::isfinite(f);
+    if (out.Values)
+    {
+      out.Values[i * C + q] = f;
+    }
+    if (gradient)
+    {
+      // grad (sum theta L / sum theta) = (sum grad(theta L) - f sum grad theta) / sum theta (3.21).
+      double l[3] = { 0, 0, 0 };
+      for (int a = 0; a < D; ++a)
+      {
+        l[a] = (sumGrad[a * C + q] - f * sumDTheta[a]) / sumTheta;
+      }
+      double* g = out.Gradients + 3 * (i * C + q);
+      this->Frame.Unproject(l, g);
+      finite = finite && std::isfinite(g[0]) && std::isfinite(g[1]) && std::isfinite(g[2]);
+    }
+  }
+  result.Valid = finite;
+  return result;
+}
+
+} // namespace meshfree
