@@ -1,0 +1,77 @@
+"""MeshFree demo: a 3D dam break of 65,536 SPH particles (the thesis' headline scene size), as PNG frames.
+
+Called by demo.py (dam_break(out)) or on its own:
+  pvpython --no-mpi demo_dambreak.py --out DIR     (plugin from $MESHFREE_PLUGIN; renders, so run under Xvfb)
+A 0.64 x 0.32 x 0.32 m block of water (spacing 1 cm) is released at the left of a 1.6 m long tank; frames every
+0.05 s up to 0.35 s, coloured by speed. About 1,300 adaptive steps: two to three minutes on two cores.
+"""
+import argparse
+import os
+import sys
+
+from paraview import simple
+
+
+def load_plugin(namespace):
+    path = os.environ.get("MESHFREE_PLUGIN")
+    if not path or not os.path.exists(path):
+        sys.exit("set MESHFREE_PLUGIN to build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so")
+    simple.LoadPlugin(path, remote=False, ns=namespace)
+
+
+def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
+    """Render the dam break into out/dambreak_NNN.png; returns the list of paths."""
+    os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+    if "SPHFluid" not in globals():
+        load_plugin(globals())  # puts the plugin's proxies (SPHFluid) into this module's namespace
+    domain = [0.0, 1.6, 0.0, 0.32, 0.0, 0.5]
+    fluid = SPHFluid(Dimension=3, ParticleSpacing=spacing, FluidBounds=[0.0, 0.64, 0.0, 0.32, 0.0, 0.32],  # noqa: F821
+                     DomainBounds=domain, Viscosity=0.001, CFLNumber=0.25, TimeStep=0.002,
+                     EndTime=end_time, OutputInterval=interval)
+    tank = simple.Box(XLength=domain[1] - domain[0], YLength=domain[3] - domain[2], ZLength=domain[5] - domain[4],
+                      Center=[(domain[0] + domain[1]) / 2, (domain[2] + domain[3]) / 2, (domain[4] + domain[5]) / 2])
+    view = simple.CreateRenderView()
+    view.ViewSize = list(size)
+    view.OrientationAxesVisibility = 0
+    view.Background = [1, 1, 1]
+    try:
+        view.UseColorPaletteForBackground = 0
+    except AttributeError:
+        pass
+    outline = simple.Show(tank, view)
+    outline.SetRepresentationType("Outline")
+    outline.AmbientColor = outline.DiffuseColor = [0.2, 0.2, 0.2]
+    display = simple.Show(fluid, view)
+    display.SetRepresentationType("Points")
+    display.PointSize = 3
+    simple.ColorBy(display, ("POINTS", "Velocity", "Magnitude"))
+    lut = simple.GetColorTransferFunction("Velocity")
+    lut.ApplyPreset("Jet", True)
+    lut.RescaleTransferFunction(0.0, 3.0)
+    display.SetScalarBarVisibility(view, True)
+    view.CameraPosition = [0.8, -1.5, 0.8]
+    view.CameraFocalPoint = [0.8, 0.16, 0.12]
+    view.CameraViewUp = [0, 0, 1]
+    paths = []
+    for k, t in enumerate(fluid.TimestepValues):
+        view.ViewTime = t
+        simple.Render(view)
+        path = os.path.join(out, "dambreak_%03d.png" % k)
+        simple.SaveScreenshot(path, view, ImageResolution=list(size))
+        paths.append(path)
+    simple.Delete(view)
+    return paths
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--out", default="demo", help="folder for the PNG frames")
+    parser.add_argument("--spacing", type=float, default=0.01, help="particle spacing (0.01: 65,536 particles)")
+    args = parser.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    for path in dam_break(args.out, spacing=args.spacing):
+        print("wrote", path)
+
+
+if __name__ == "__main__":
+    main()

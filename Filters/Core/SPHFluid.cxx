@@ -1,0 +1,581 @@
+// SPH fluid core, part 2: neighbour lists, density and forces, leap-frog stepping (the model is described in
+// SPHFluid.h). Part 1, the setup and initial state, is SPHSetup.cxx.
+#include "SPHFluid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <omp.h>
+
+namespace meshfree
+{
+namespace
+{
+constexpr double StabilityLambda = 0.4; // largest CFL factor a fixed step may use before it is reduced
+constexpr double SurfaceThreshold = 0.25; // |grad c| h above which a particle is on the surface
+constexpr Index ParallelThreshold = 4096; // below: one thread (a fork-join would cost more than the work)
+}
+
+void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
+{
+  const Index n = state.Size();
+  const double* x = state.Position.data();
+  const int threads = omp_get_max_threads();
+  this->ThreadFluid.resize(threads);
+  this->ThreadBoundary.resize(threads);
+  this->FluidStart.assign(n + 1, 0);
+  this->BoundaryStart.assign(n + 1, 0);
+  std::vector<Index> firstOfThread(threads, n);
+  const bool boundary = withBoundary && this->BoundaryCount > 0;
+#pragma omp parallel if (n >= ParallelThreshold)
+  {
+    const int t = omp_get_thread_num();
+    std::vector<std::int32_t>& fluid = this->ThreadFluid[t];
+    std::vector<std::int32_t>& wall = this->ThreadBoundary[t];
+    fluid.clear();
+    wall.clear();
+    std::vector<Index> ids;
+    ids.reserve(256);
+    // Static schedule: each thread handles one contiguous, increasing block of particles, so its lists are
+    // the global lists of that block, in order.
+#pragma omp for schedule(static)
+    for (Index i = 0; i < n; ++i)
+    {
+      if (firstOfThread[t] == n)
+      {
+        firstOfThread[t] = i;
+      }
+      this->Grid.FindWithinRadius(x + 3 * i, this->H, ids);
+      Index c = 0;
+      for (Index j : ids)
+      {
+        if (j != i)
+        {
+          fluid.push_back(static_cast<std::int32_t>(j));
+          ++c;
+        }
+      }
+      this->FluidStart[i + 1] = c;
+      if (boundary && this->NearBoundary(x + 3 * i))
+      {
+        this->BoundaryGrid.FindWithinRadius(x + 3 * i, this->H, ids);
+        for (Index b : ids)
+        {
+          wall.push_back(static_cast<std::int32_t>(b));
+        }
+        this->BoundaryStart[i + 1] = static_cast<Index>(ids.size());
+      }
+    }
+  }
+  for (Index i = 0; i < n; ++i)
+  {
+    this->FluidStart[i + 1] += this->FluidStart[i];
+    this->BoundaryStart[i + 1] += this->BoundaryStart[i];
+  }
+  this->FluidNeighbors.resize(this->FluidStart[n]);
+  this->BoundaryNeighbors.resize(this->BoundaryStart[n]);
+#pragma omp parallel if (n >= ParallelThreshold)
+  {
+    const int t = omp_get_thread_num();
+    if (firstOfThread[t] < n)
+    {
+      std::copy(this->ThreadFluid[t].begin(), this->ThreadFluid[t].end(),
+        this->FluidNeighbors.begin() + this->FluidStart[firstOfThread[t]]);
+      std::copy(this->ThreadBoundary[t].begin(), this->ThreadBoundary[t].end(),
+        this->BoundaryNeighbors.begin() + this->BoundaryStart[firstOfThread[t]]);
+    }
+  }
+}
+
+void SPHFluid::ComputeAccelerations(SPHState& state)
+{
+  const Index n = state.Size();
+  if (n == 0)
+  {
+    return;
+  }
+  const SPHParameters& p = this->Params;
+  this->Grid.Build(state.Position.data(), n, this->H);
+  this->BuildNeighborLists(state, true);
+  const double* x = state.Position.data();
+  const double* v = state.Velocity.data();
+  double* rho = state.Density.data();
+  double* pressure = state.Pressure.data();
+  double* acc = state.Acceleration.data();
+  const double h = this->H, h2 = this->H2, m = this->Mass;
+  const double poly6 = this->Poly6, densityNorm = this->DensityNorm, gradientNorm = this->GradientNorm;
+  const double visc = this->ViscLap;
+  const double* bx = this->BoundaryPosition.data();
+  const Index* fs = this->FluidStart.data();
+  const Index* bs = this->BoundaryStart.data();
+  const std::int32_t* fn = this->FluidNeighbors.data();
+  const std::int32_t* bn = this->BoundaryNeighbors.data();
+
+  // Density (5.32) and pressure (5.40 / Tait).
+#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
+  for (Index i = 0; i < n; ++i)
+  {
+    const double* xi = x + 3 * i;
+    double fluidSum = this->DensityShape(0.0); // itself
+    for (Index s = fs[i]; s < fs[i + 1]; ++s)
+    {
+      const double* xj = x + 3 * fn[s];
+      const double dx = xi[0] - xj[0], dy = xi[1] - xj[1], dz = xi[2] - xj[2];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      if (r2 < h2)
+      {
+        fluidSum += this->DensityShape(r2);
+      }
+    }
+    for (Index s = bs[i]; s < bs[i + 1]; ++s)
+    {
+      const double* xb = bx + 3 * bn[s];
+      const double dx = xi[0] - xb[0], dy = xi[1] - xb[1], dz = xi[2] - xb[2];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      if (r2 < h2)
+      {
+        fluidSum += this->DensityShape(r2); // dummies weigh like fluid particles
+      }
+    }
+    rho[i] = densityNorm * m * fluidSum;
+    pressure[i] = this->PressureOf(rho[i]);
+  }
+
+  // Pressure of the dummies next to the fluid, extrapolated from their fluid neighbours with the hydrostatic
+  // increase (Adami, Hu & Adams 2012, eq. 27 for static walls): p_b = (sum_f p_f W + g . sum_f rho_f (x_b - x_f) W)
+  // / sum_f W, and their density from the equation of state.
+  const double g[3] = { p.Gravity[0], p.Gravity[1], p.Gravity[2] };
+  const Index nb = this->BoundaryCount;
+  if (nb > 0)
+  {
+    this->BoundaryPressure.assign(nb, 0.0);
+    this->BoundaryActive.assign(nb, 0);
+    const Index total = bs[n];
+#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
+    for (Index s = 0; s < total; ++s)
+    {
+      this->BoundaryActive[bn[s]] = 1; // same value from every thread
+    }
+    double* pb = this->BoundaryPressure.data();
+    const char* active = this->BoundaryActive.data();
+#pragma omp parallel if (n >= ParallelThreshold)
+    {
+      std::vector<Index> ids;
+#pragma omp for schedule(dynamic, 256)
+      for (Index b = 0; b < nb; ++b)
+      {
+        if (!active[b])
+        {
+          continue;
+        }
+        const double* xb = bx + 3 * b;
+        this->Grid.FindWithinRadius(xb, h, ids);
+        double sumW = 0.0, sumP = 0.0, sumG = 0.0;
+        for (Index f : ids)
+        {
+          const double* xf = x + 3 * f;
+          const double r[3] = { xb[0] - xf[0], xb[1] - xf[1], xb[2] - xf[2] };
+          const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+          if (r2 < h2)
+          {
+            const double w = this->DensityShape(r2);
+            sumW += w;
+            sumP += pressure[f] * w;
+            sumG += rho[f] * (g[0] * r[0] + g[1] * r[1] + g[2] * r[2]) * w;
+          }
+        }
+        pb[b] = sumW > 0.0 ? std::max(0.0, (sumP + sumG) / sumW) : 0.0;
+      }
+    }
+  }
+  const double* pb = this->BoundaryPressure.data();
+
+  // Forces: pressure (5.37, symmetric), viscosity (5.46), colour-field surface tension, gravity.
+  const double mu = p.Viscosity, sigma = p.SurfaceTension;
+  const bool viscous = mu > 0.0, tension = sigma > 0.0;
+  const int d = p.Dimension;
+#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
+  for (Index i = 0; i < n; ++i)
+  {
+    const double* xi = x + 3 * i;
+    const double* vi = v + 3 * i;
+    const double rhoI = rho[i];
+    const double termI = pressure[i] / (rhoI * rhoI);
+    double ap[3] = { 0.0, 0.0, 0.0 }, av[3] = { 0.0, 0.0, 0.0 }, normal[3] = { 0.0, 0.0, 0.0 };
+    double colourLaplacian = 0.0;
+    for (Index s = fs[i]; s < fs[i + 1]; ++s)
+    {
+      const Index j = fn[s];
+      const double* xj = x + 3 * j;
+      const double r[3] = { xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2] };
+      const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+      if (!(r2 < h2))
+      {
+        continue;
+      }
+      const double dist = std::sqrt(r2);
+      const double rhoJ = rho[j];
+      if (dist > 0.0)
+      {
+        // -m (p_i/rho_i^2 + p_j/rho_j^2) grad W, grad W = -gradientNorm shape(r) r
+        const double coefficient =
+          m * (termI + pressure[j] / (rhoJ * rhoJ)) * gradientNorm * this->GradientShape(r2, dist);
+        ap[0] += coefficient * r[0];
+        ap[1] += coefficient * r[1];
+        ap[2] += coefficient * r[2];
+      }
+      if (viscous)
+      {
+        const double coefficient = mu * m * visc * (h - dist) / (rhoI * rhoJ);
+        const double* vj = v + 3 * j;
+        av[0] += coefficient * (vj[0] - vi[0]);
+        av[1] += coefficient * (vj[1] - vi[1]);
+        av[2] += coefficient * (vj[2] - vi[2]);
+      }
+      if (tension)
+      {
+        const double q = h2 - r2;
+        const double volume = m / rhoJ;
+        const double gradient = -6.0 * poly6 * q * q; // grad W_poly6 = gradient * r
+        normal[0] += volume * gradient * r[0];
+        normal[1] += volume * gradient * r[1];
+        normal[2] += volume * gradient * r[2];
+        colourLaplacian += volume * -6.0 * poly6 * q * (d * q - 4.0 * r2);
+      }
+    }
+    for (Index s = bs[i]; s < bs[i + 1]; ++s)
+    {
+      const Index b = bn[s];
+      const double* xb = bx + 3 * b;
+      const double r[3] = { xi[0] - xb[0], xi[1] - xb[1], xi[2] - xb[2] };
+      const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+      if (!(r2 < h2))
+      {
+        continue;
+      }
+      const double dist = std::sqrt(r2);
+      if (dist > 0.0)
+      {
+        // Symmetric pair force with the dummy's extrapolated pressure; its density from the EOS.
+        const double rhoB = this->DensityOf(pb[b]);
+        const double coefficient =
+          m * (termI + pb[b] / (rhoB * rhoB)) * gradientNorm * this->GradientShape(r2, dist);
+        ap[0] += coefficient * r[0];
+        ap[1] += coefficient * r[1];
+        ap[2] += coefficient * r[2];
+      }
+      if (tension)
+      {
+        // Walls count as fluid in the colour field (neutral wetting): no spurious surface along them.
+        const double q = h2 - r2;
+        const double volume = m / p.RestDensity;
+        const double gradient = -6.0 * poly6 * q * q;
+        normal[0] += volume * gradient * r[0];
+        normal[1] += volume * gradient * r[1];
+        normal[2] += volume * gradient * r[2];
+        colourLaplacian += volume * -6.0 * poly6 * q * (d * q - 4.0 * r2);
+      }
+    }
+    double* ai = acc + 3 * i;
+    ai[0] = ap[0] + av[0] + g[0];
+    ai[1] = ap[1] + av[1] + g[1];
+    ai[2] = ap[2] + av[2] + g[2];
+    if (tension)
+    {
+      const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+      if (length * h > SurfaceThreshold)
+      {
+        const double factor = -sigma * colourLaplacian / (length * rhoI);
+        ai[0] += factor * normal[0];
+        ai[1] += factor * normal[1];
+        ai[2] += factor * normal[2];
+      }
+    }
+    if (d == 2)
+    {
+      ai[1] = 0.0;
+    }
+  }
+}
+
+void SPHFluid::Enforce(SPHState& state, Index begin, Index end) const
+{
+  const SPHParameters& p = this->Params;
+  const bool obstacles = !this->ObstaclePosition.empty();
+  std::vector<Index> nearest(1);
+  std::vector<double> nearestD2(1);
+  for (Index i = begin; i < end; ++i)
+  {
+    double* x = &state.Position[3 * i];
+    double* v = &state.Velocity[3 * i];
+    if (p.Walls)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        if (a == 1 && p.Dimension == 2)
+        {
+          continue;
+        }
+        const double low = p.DomainBounds[2 * a] + this->WallMargin;
+        const double high = p.DomainBounds[2 * a + 1] - this->WallMargin;
+        if (x[a] < low)
+        {
+          x[a] = low;
+          v[a] = std::max(v[a], 0.0);
+        }
+        else if (x[a] > high)
+        {
+          x[a] = high;
+          v[a] = std::min(v[a], 0.0);
+        }
+      }
+    }
+    if (obstacles && this->NearObstacle(x) && this->ObstacleGrid.FindKNearest(x, 1, nearest, nearestD2) == 1)
+    {
+      const double* s = &this->ObstaclePosition[3 * nearest[0]];
+      const double* nrm = &this->ObstacleNormal[3 * nearest[0]];
+      const double depth = (x[0] - s[0]) * nrm[0] + (x[1] - s[1]) * nrm[1] + (x[2] - s[2]) * nrm[2];
+      if (depth < this->WallMargin)
+      {
+        const double push = this->WallMargin - depth;
+        const double vn = v[0] * nrm[0] + v[1] * nrm[1] + v[2] * nrm[2];
+        for (int a = 0; a < 3; ++a)
+        {
+          x[a] += push * nrm[a];
+          v[a] -= vn < 0.0 ? vn * nrm[a] : 0.0;
+        }
+      }
+    }
+  }
+}
+
+void SPHFluid::Reorder(SPHState& state)
+{
+  const Index n = state.Size();
+  this->Grid.Build(state.Position.data(), n, this->H);
+  const std::vector<Index>& order = this->Grid.SortedOrder();
+  if (static_cast<Index>(order.size()) != n)
+  {
+    return;
+  }
+  auto permute3 = [&](std::vector<double>& a) {
+    std::vector<double> b(a.size());
+#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
+    for (Index s = 0; s < n; ++s)
+    {
+      b[3 * s] = a[3 * order[s]];
+      b[3 * s + 1] = a[3 * order[s] + 1];
+      b[3 * s + 2] = a[3 * order[s] + 2];
+    }
+    a.swap(b);
+  };
+  permute3(state.Position);
+  permute3(state.Velocity);
+  permute3(state.Acceleration);
+  std::vector<std::int64_t> id(n);
+  for (Index s = 0; s < n; ++s)
+  {
+    id[s] = state.Id[order[s]];
+  }
+  state.Id.swap(id);
+  // Density and pressure are recomputed by the next force evaluation.
+}
+
+double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
+{
+  const Index n = state.Size();
+  double v2max = 0.0, a2max = 0.0, rhoMax = this->Params.RestDensity;
+  bool finite = true;
+#pragma omp parallel for if (n >= ParallelThreshold) schedule(static) reduction(max : v2max, a2max, rhoMax) reduction(&& : finite)
+  for (Index i = 0; i < n; ++i)
+  {
+    const double* v = &state.Velocity[3 * i];
+    const double* a = &state.Acceleration[3 * i];
+    const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    const double a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    finite = finite && std::isfinite(v2) && std::isfinite(a2) && std::isfinite(state.Density[i]);
+    v2max = std::max(v2max, v2);
+    a2max = std::max(a2max, a2);
+    rhoMax = std::max(rhoMax, state.Density[i]);
+  }
+  if (!finite)
+  {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  double c = this->C0;
+  if (this->Params.EquationOfState == SPHEquationOfState::Tait)
+  {
+    const double ratio = rhoMax / this->Params.RestDensity; // c^2 = dp/drho = c0^2 (rho/rho0)^6
+    c *= ratio * ratio * ratio;
+  }
+  const double h = this->H;
+  double dt = h / (c + std::sqrt(v2max));
+  const double amax = std::sqrt(a2max);
+  if (amax > 0.0)
+  {
+    dt = std::min(dt, std::sqrt(h / amax));
+  }
+  if (this->Nu > 0.0)
+  {
+    dt = std::min(dt, 0.125 * h * h / this->Nu);
+  }
+  return lambda * dt;
+}
+
+SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const ProgressFunction& progress)
+{
+  const SPHParameters& p = this->Params;
+  const double start = state.Time;
+  if (!(targetTime >= start) || !std::isfinite(targetTime))
+  {
+    this->Error = "the target time lies before the state's time";
+    return Status::Failed;
+  }
+  const Index n = state.Size();
+  long steps = 0;
+  while (state.Time < targetTime)
+  {
+    const double remaining = targetTime - state.Time;
+    if (n == 0)
+    {
+      state.Time = targetTime;
+      break;
+    }
+    double dt;
+    if (p.CFLNumber > 0.0)
+    {
+      dt = std::min(p.TimeStep, this->StableTimeStep(state, p.CFLNumber));
+    }
+    else
+    {
+      const double stable = this->StableTimeStep(state, StabilityLambda);
+      dt = p.TimeStep;
+      if (dt > stable)
+      {
+        dt = stable;
+        ++this->ReducedStepCount;
+      }
+    }
+    if (!(dt > 0.0) || !std::isfinite(dt))
+    {
+      std::ostringstream s;
+      s << "the simulation became unstable (non-finite velocity, acceleration or density) at t = " << state.Time;
+      this->Error = s.str();
+      return Status::Failed;
+    }
+    bool last = false;
+    if (dt >= remaining)
+    {
+      dt = remaining;
+      last = true;
+    }
+    else if (dt > 0.5 * remaining)
+    {
+      dt = 0.5 * remaining; // two equal steps rather than a sliver at the end
+    }
+    if (remaining / dt > static_cast<double>(p.MaximumStepsPerInterval - steps))
+    {
+      std::ostringstream s;
+      s << "the time step collapsed to " << dt << " s at t = " << state.Time << ": reaching t = " << targetTime
+        << " would take more than " << p.MaximumStepsPerInterval
+        << " steps (is GasStiffness or the velocity absurdly large?)";
+      this->Error = s.str();
+      return Status::Failed;
+    }
+
+    // Kick - drift (with the wall and obstacle projection).
+    const double half = 0.5 * dt;
+#pragma omp parallel if (n >= ParallelThreshold)
+    {
+      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+      const Index begin = n * t / threads, end = n * (t + 1) / threads;
+      for (Index i = begin; i < end; ++i)
+      {
+        double* x = &state.Position[3 * i];
+        double* v = &state.Velocity[3 * i];
+        const double* a = &state.Acceleration[3 * i];
+        for (int c = 0; c < 3; ++c)
+        {
+          v[c] += half * a[c];
+          x[c] += dt * v[c];
+        }
+      }
+      this->Enforce(state, begin, end);
+    }
+    if (state.Steps % p.ReorderInterval == 0)
+    {
+      this->Reorder(state);
+    }
+    this->ComputeAccelerations(state);
+    // Kick.
+#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
+    for (Index i = 0; i < 3 * n; ++i)
+    {
+      state.Velocity[i] += half * state.Acceleration[i];
+    }
+    state.Time = last ? targetTime : state.Time + dt;
+    ++state.Steps;
+    ++steps;
+    if (progress && (steps & 15) == 0 && !progress((state.Time - start) / (targetTime - start)))
+    {
+      return Status::Aborted;
+    }
+  }
+  return Status::Ok;
+}
+
+std::vector<int> SPHFluid::NeighborCounts(const SPHState& state)
+{
+  const Index n = state.Size();
+  std::vector<int> counts(n, 0);
+  if (n == 0)
+  {
+    return counts;
+  }
+  this->Grid.Build(state.Position.data(), n, this->H);
+#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
+  for (Index i = 0; i < n; ++i)
+  {
+    // Strictly inside the support, as the sums count them.
+    Index c = 0;
+    const double* xi = &state.Position[3 * i];
+    std::vector<Index> ids;
+    std::vector<double> d2;
+    this->Grid.FindWithinRadius(xi, this->H, ids, &d2);
+    for (std::size_t k = 0; k < ids.size(); ++k)
+    {
+      c += (ids[k] != i && d2[k] < this->H2) ? 1 : 0;
+    }
+    counts[i] = static_cast<int>(c);
+  }
+  return counts;
+}
+
+SPHStatistics SPHFluid::Statistics(const SPHState& state, double mass)
+{
+  SPHStatistics s;
+  const Index n = state.Size();
+  s.MinDensity = n > 0 ? std::numeric_limits<double>::max() : 0.0;
+  s.MaxDensity = 0.0;
+  for (Index i = 0; i < n; ++i)
+  {
+    const double* v = &state.Velocity[3 * i];
+    const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    for (int a = 0; a < 3; ++a)
+    {
+      s.Momentum[a] += mass * v[a];
+    }
+    s.KineticEnergy += 0.5 * mass * v2;
+    s.MaxSpeed = std::max(s.MaxSpeed, std::sqrt(v2));
+    s.MinDensity = std::min(s.MinDensity, state.Density[i]);
+    s.MaxDensity = std::max(s.MaxDensity, state.Density[i]);
+    s.Finite = s.Finite && std::isfinite(v2) && std::isfinite(state.Position[3 * i]) &&
+      std::isfinite(state.Position[3 * i + 1]) && std::isfinite(state.Position[3 * i + 2]) &&
+      std::isfinite(state.Density[i]) && std::isfinite(state.Pressure[i]);
+  }
+  return s;
+}
+
+} // namespace meshfree

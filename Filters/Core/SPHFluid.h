@@ -1,0 +1,248 @@
+// MeshFree core: weakly compressible SPH fluid after Mueller, Charypar & Gross 2003 (thesis ch. 5), VTK-free.
+//
+// Model (equation numbers of the thesis, DIGEST.md ch. 5):
+//  * density    rho_i = sum_j m W(r_ij) over fluid and boundary particles                     [5.32]
+//  * pressure   'Ideal' p = k (rho - rho0) [5.40]; 'Tait' p = B ((rho/rho0)^7 - 1), B = rho0 k / 7, k = c0^2
+//               (Becker & Teschner 2007). Negative pressures are clamped to 0: a free-surface particle misses
+//               neighbours, so its density is underestimated; a negative pressure would pull it into its
+//               neighbours (clumping, tensile instability). Clamping removes the spurious attraction.
+//  * pressure force, symmetric [5.37, the thesis' stray factor p_i removed]:
+//               a_i = -sum_j m (p_i/rho_i^2 + p_j/rho_j^2) grad W(r_ij)
+//  * viscosity  [5.46]: a_i = (mu / rho_i) sum_j m (v_j - v_i) / rho_j lap W_visc(r_ij), lap W_visc = L (h - r)
+//               (5.49; in 2D L = 40/(pi h^5), the constant that makes the estimate exact for quadratic fields,
+//               as 45/(pi h^6) does in 3D)
+//  * surface tension from the poly6 colour field c = sum m/rho W: a_i = -sigma lap(c) n/|n| / rho_i where
+//    |n| = |grad c| > 0.25 / h (Mueller 2003, 5.3.4); walls count as fluid in c (neutral wetting)
+//  * gravity.
+// Kernels (SPHKernelPair): Mueller 2003 computes the density with poly6 and the pressure force with the spiky
+// gradient. That pair is not the gradient of an energy: at the stiffness that keeps water within 1 % of rho0
+// (k = 100 g H) an inviscid block in free space gains energy without bound (TestSPHFluid shows it), and the
+// dam break explodes. The default, 'Spiky', uses the spiky kernel [5.41] for both (grad W = -3 s (h - r)^2 r/|r|):
+// the inviscid system is then Hamiltonian and, the spiky gradient growing up to r = 0, free of particle pairing.
+// 'Poly6' uses poly6 for both; 'Mueller' keeps the thesis' pair for comparison.
+// With equal masses the pressure and viscosity terms are antisymmetric pair forces: linear momentum is conserved.
+//
+// Kernel constants (h = support radius, the only length) are the continuous normalisations corrected once on
+// the initial lattice of spacing dx (Bonet & Lok 1999 consistency conditions, applied as global factors so the
+// pair forces stay antisymmetric): sum_j V W = 1, sum_j V (x_j - x_i) (x) grad W = -I and sum_j V r^2 L = 2d.
+// Without them the spiky gradient of a 2D lattice with h = 2 dx is 11 % weak and the hydrostatic pressure
+// gradient 11 % too steep.
+//
+// Boundaries: dummy particles (SPHBoundary.h) on the fluid's lattice, filling a shell of the support's thickness
+// behind the container walls and inside obstacles. They count in the density sum like fluid particles, and their
+// pressure is extrapolated from the fluid next to them with the hydrostatic increase (Adami, Hu & Adams 2012,
+// eq. 27 for static walls); the fluid-dummy force is the symmetric pair force. With p >= 0 walls only repel, so
+// the fluid does not stick to them (free slip). As a guarantee on top of that, every drift is followed by a
+// projection: a particle that would cross a wall is put back a small margin inside and loses its outward normal
+// velocity; an obstacle crossing is detected by the nearest obstacle surface sample's outward normal and
+// projected back the same way.
+//
+// Initial state: the block on its lattice, compressed along gravity as a column at rest would be (with the
+// lattice's own density response to a uniaxial strain), so that the release starts without a pressure wave.
+//
+// Time integration: kick-drift-kick leap-frog (velocity Verlet), one force evaluation per step; the viscous
+// force uses the half-step velocity. Step (CFL): dt = lambda min(h / (c + v_max), sqrt(h / a_max), 0.125 h^2/nu),
+// capped by TimeStep; with CFLNumber = 0 the step is TimeStep unless it exceeds the stability limit (lambda = 0.4),
+// in which case it is reduced and the reduction counted (the VTK layer warns). Steps land exactly on the
+// requested times (the last two steps before a target share the remaining time rather than leave a sliver).
+//
+// Storage is structure of arrays: one array per attribute (position and velocity are xyz triplets, the layout
+// the shared NeighborGrid reads). Neighbour lists are rebuilt every step from the grid (one query per particle,
+// then every pass streams through the lists). Every ReorderInterval steps the particle arrays are permuted into
+// the grid's Z-order so that neighbours are close in memory. Everything the future depends on is in SPHState, so
+// a state restored from a cache continues bit-identically, whatever the number of threads.
+#ifndef meshfree_SPHFluid_h
+#define meshfree_SPHFluid_h
+
+#include "NeighborGrid.h"
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace meshfree
+{
+
+enum class SPHEquationOfState
+{
+  Ideal = 0, ///< p = k (rho - rho0), the thesis [5.40]
+  Tait = 1   ///< p = B ((rho/rho0)^7 - 1), Becker & Teschner 2007
+};
+
+/// Which kernels give the density and the pressure force's gradient.
+enum class SPHKernelPair
+{
+  Spiky = 0,  ///< spiky density and the spiky gradient [5.41]: energy-conserving, no particle pairing
+  Poly6 = 1,  ///< poly6 density [5.32] and its gradient: energy-conserving
+  Mueller = 2 ///< poly6 density, spiky gradient (Mueller 2003, the thesis): not energy-conserving
+};
+
+struct SPHParameters
+{
+  int Dimension = 3;                                          ///< 3, or 2 (x-z plane, y ignored)
+  double FluidBounds[6] = { 0.0, 0.1, 0.0, 0.1, 0.0, 0.2 };   ///< initial block, filled on the lattice
+  double DomainBounds[6] = { 0.0, 0.4, 0.0, 0.1, 0.0, 0.25 }; ///< closed container
+  bool Walls = true;                 ///< false: free space (no container; for tests)
+  double ParticleSpacing = 0.01;     ///< dx; mass = RestDensity dx^Dimension
+  double SmoothingLength = 0.0;      ///< kernel support radius h; 0: 2 dx
+  double RestDensity = 1000.0;       ///< rho0
+  double GasStiffness = 0.0;         ///< k (Ideal, m^2/s^2) or c0^2 (Tait); 0: automatic (see AutoStiffness)
+  SPHEquationOfState EquationOfState = SPHEquationOfState::Ideal;
+  SPHKernelPair Kernels = SPHKernelPair::Spiky;
+  double Viscosity = 0.0;            ///< dynamic viscosity mu, Pa s
+  double SurfaceTension = 0.0;       ///< sigma, N/m
+  double Gravity[3] = { 0.0, 0.0, -9.81 };
+  double TimeStep = 1e-3;            ///< largest step, s
+  double CFLNumber = 0.25;           ///< lambda; 0: fixed step
+  double BoundarySpacingFactor = 0.5; ///< obstacle surface sampling spacing / dx (inside test)
+  int ReorderInterval = 25;           ///< steps between Z-order permutations of the particle arrays
+  long MaximumStepsPerInterval = 2000000; ///< a call to Advance() fails rather than take more steps
+};
+
+/// Everything the future of a simulation depends on (positions, velocities, the last acceleration), plus the
+/// derived fields at the same instant for output.
+struct SPHState
+{
+  double Time = 0.0;
+  long Steps = 0;
+  std::vector<double> Position;     ///< 3n, x y z (y = 0 in 2D)
+  std::vector<double> Velocity;     ///< 3n
+  std::vector<double> Acceleration; ///< 3n, a(x_n) used by the next kick
+  std::vector<double> Density;      ///< n
+  std::vector<double> Pressure;     ///< n
+  std::vector<std::int64_t> Id;     ///< n, stable across time
+
+  Index Size() const { return static_cast<Index>(this->Id.size()); }
+};
+
+/// Whole-fluid statistics of a state (tests, diagnostics).
+struct SPHStatistics
+{
+  double Momentum[3] = { 0.0, 0.0, 0.0 };
+  double KineticEnergy = 0.0;
+  double MaxSpeed = 0.0;
+  double MinDensity = 0.0;
+  double MaxDensity = 0.0;
+  bool Finite = true;
+};
+
+class SPHFluid
+{
+public:
+  enum class Status
+  {
+    Ok,
+    Aborted, ///< the progress callback returned false
+    Failed   ///< see ErrorMessage()
+  };
+
+  /// fraction in [0, 1] of the current Advance(); return false to abort.
+  using ProgressFunction = std::function<bool(double fraction)>;
+
+  /// Validates the parameters and prepares kernels, stiffness and boundary particles. `obstacleTriangles`
+  /// holds 9 doubles per triangle of closed surfaces the fluid flows around (their orientation is fixed
+  /// here: normals are made to point outwards). Throws std::invalid_argument with a clear message for
+  /// unusable settings; recoverable problems are listed in Warnings().
+  void Setup(const SPHParameters& parameters, const std::vector<double>& obstacleTriangles = {});
+
+  /// The state at t = 0: the fluid block on its lattice (particles outside the container or inside an
+  /// obstacle are left out, with a warning), at rest, with density, pressure and acceleration evaluated.
+  SPHState InitialState();
+
+  /// Advances `state` to exactly `targetTime` (>= state.Time).
+  Status Advance(SPHState& state, double targetTime, const ProgressFunction& progress = nullptr);
+
+  /// Number of fluid neighbours (within h, itself excluded) of every particle of `state`.
+  std::vector<int> NeighborCounts(const SPHState& state);
+
+  static SPHStatistics Statistics(const SPHState& state, double particleMass);
+
+  const std::vector<std::string>& Warnings() const { return this->WarningList; }
+  const std::string& ErrorMessage() const { return this->Error; }
+  /// Steps whose fixed TimeStep was above the stability limit and was reduced (since Setup()).
+  long ReducedSteps() const { return this->ReducedStepCount; }
+
+  const SPHParameters& Parameters() const { return this->Params; }
+  double SupportRadius() const { return this->H; }
+  double ParticleMass() const { return this->Mass; }
+  /// k of the Ideal EOS (m^2/s^2), or c0^2 of Tait, as used (after the automatic choice).
+  double Stiffness() const { return this->K; }
+  double SoundSpeed() const { return this->C0; }
+  Index NumberOfBoundaryParticles() const { return this->BoundaryCount; }
+  /// Kernel factors applied by the lattice correction (poly6, spiky gradient, viscosity Laplacian).
+  void GetLatticeCorrections(double c[3]) const;
+
+  /// The k rule of the issue: Ideal k = 100 g H, Tait c0 = 10 sqrt(g H) (c0^2 returned), H = fluid height
+  /// along gravity (standard gravity when |g| = 0).
+  static double AutoStiffness(const SPHParameters& parameters);
+
+  /// Largest stable step for the current state and CFL factor lambda (see the header comment).
+  double StableTimeStep(const SPHState& state, double lambda) const;
+
+private:
+  void ComputeAccelerations(SPHState& state);
+  void BuildNeighborLists(const SPHState& state, bool withBoundary);
+  void Reorder(SPHState& state);
+  void Enforce(SPHState& state, Index begin, Index end) const;
+  bool NearBoundary(const double* x) const;
+  bool NearObstacle(const double* x) const;
+  double PressureOf(double density) const;
+  double DensityOf(double pressure) const; // inverse of the equation of state for p >= 0
+
+  SPHParameters Params;
+  std::vector<std::string> WarningList;
+  std::string Error;
+  long ReducedStepCount = 0;
+  double H = 0.02, H2 = 4e-4;
+  double Mass = 1.0;
+  double K = 0.0, C0 = 0.0, TaitB = 0.0;
+  double Nu = 0.0;
+  // Density W = DensityNorm DensityShape(r^2); grad W = -GradientNorm GradientShape(r^2, r) r_vec.
+  double DensityShape(double r2) const
+  {
+    if (this->SpikyDensity)
+    {
+      const double u = this->H - std::sqrt(r2);
+      return u * u * u;
+    }
+    const double q = this->H2 - r2;
+    return q * q * q;
+  }
+  double GradientShape(double r2, double r) const
+  {
+    if (this->SpikyGradient)
+    {
+      return (this->H - r) * (this->H - r) / r;
+    }
+    const double q = this->H2 - r2;
+    return q * q;
+  }
+  bool SpikyDensity = false, SpikyGradient = false;
+  double DensityNorm = 0.0, DensityCorrection = 1.0, CompressionResponse = 1.0;
+  double GradientNorm = 0.0, GradientCorrection = 1.0;
+  double Poly6 = 0.0;                         // colour field, lattice-normalised
+  double ViscLap = 0.0, ViscCorrection = 1.0; // lap W = ViscLap (h - r)
+  double WallMargin = 0.0;
+
+  // Boundary (dummy) particles, static; obstacle surface samples with outward normals; their grids.
+  std::vector<double> BoundaryPosition;
+  Index BoundaryCount = 0;
+  std::vector<double> BoundaryPressure; // extrapolated each step, for dummies next to the fluid
+  std::vector<char> BoundaryActive;
+  NeighborGrid BoundaryGrid;
+  std::vector<double> ObstaclePosition, ObstacleNormal;
+  NeighborGrid ObstacleGrid;
+  double ObstacleBox[6] = { 0, -1, 0, -1, 0, -1 };
+
+  // Per-step scratch.
+  NeighborGrid Grid;
+  std::vector<Index> FluidStart, BoundaryStart;
+  std::vector<std::int32_t> FluidNeighbors, BoundaryNeighbors;
+  std::vector<std::vector<std::int32_t>> ThreadFluid, ThreadBoundary;
+};
+
+} // namespace meshfree
+
+#endif

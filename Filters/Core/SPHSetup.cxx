@@ -1,0 +1,448 @@
+// SPH fluid core, part 1: parameters, kernels and their lattice corrections, boundary particles and the initial
+// state (the model is described in SPHFluid.h). Part 2, the time stepping, is SPHFluid.cxx.
+#include "SPHFluid.h"
+
+#include "SPHBoundary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include <omp.h>
+
+namespace meshfree
+{
+namespace
+{
+constexpr double Pi = 3.141592653589793238462643383279502884;
+constexpr Index MaximumParticles = 100000000;
+
+bool Finite(const double* v, int n)
+{
+  for (int i = 0; i < n; ++i)
+  {
+    if (!std::isfinite(v[i]))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Number of lattice nodes of spacing dx filling [lo, hi] (nodes at lo + (i + 1/2) dx).
+Index LatticeCount(double lo, double hi, double dx)
+{
+  const double n = std::floor((hi - lo) / dx + 0.5);
+  return n > 0.0 ? static_cast<Index>(n) : 0;
+}
+}
+
+double SPHFluid::AutoStiffness(const SPHParameters& p)
+{
+  double g[3] = { p.Gravity[0], p.Dimension == 2 ? 0.0 : p.Gravity[1], p.Gravity[2] };
+  double gNorm = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+  if (!(gNorm > 0.0))
+  {
+    g[0] = g[1] = 0.0;
+    g[2] = gNorm = 9.81;
+  }
+  double height = 0.0; // extent of the fluid block along gravity
+  for (int a = 0; a < 3; ++a)
+  {
+    height += std::fabs(g[a] / gNorm) * std::max(0.0, p.FluidBounds[2 * a + 1] - p.FluidBounds[2 * a]);
+  }
+  height = std::max(height, p.ParticleSpacing);
+  // Ideal: bottom compression g H / k <= 1 %  <=>  k >= 100 g H. Tait: c0 >= 10 sqrt(g H)  <=>  c0^2 >= 100 g H.
+  return 100.0 * gNorm * height;
+}
+
+void SPHFluid::GetLatticeCorrections(double c[3]) const
+{
+  c[0] = this->DensityCorrection;
+  c[1] = this->GradientCorrection;
+  c[2] = this->ViscCorrection;
+}
+
+void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>& obstacleTriangles)
+{
+  const SPHParameters& p = parameters;
+  this->WarningList.clear();
+  this->Error.clear();
+  this->ReducedStepCount = 0;
+  auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
+  if (p.Dimension != 2 && p.Dimension != 3)
+  {
+    fail("Dimension must be 2 or 3");
+  }
+  if (!(p.ParticleSpacing > 0.0) || !std::isfinite(p.ParticleSpacing))
+  {
+    fail("ParticleSpacing must be a positive number");
+  }
+  if (!(p.RestDensity > 0.0) || !std::isfinite(p.RestDensity))
+  {
+    fail("RestDensity must be a positive number");
+  }
+  if (!(p.SmoothingLength >= 0.0) || !std::isfinite(p.SmoothingLength))
+  {
+    fail("SmoothingLength must be 0 (automatic) or positive");
+  }
+  if (!(p.GasStiffness >= 0.0) || !std::isfinite(p.GasStiffness))
+  {
+    fail("GasStiffness must be 0 (automatic) or positive");
+  }
+  if (!(p.Viscosity >= 0.0) || !std::isfinite(p.Viscosity) || !(p.SurfaceTension >= 0.0) ||
+    !std::isfinite(p.SurfaceTension))
+  {
+    fail("Viscosity and SurfaceTension must be >= 0");
+  }
+  if (!(p.TimeStep > 0.0) || !std::isfinite(p.TimeStep) || !(p.CFLNumber >= 0.0) || !std::isfinite(p.CFLNumber))
+  {
+    fail("TimeStep must be positive and CFLNumber >= 0");
+  }
+  if (!Finite(p.Gravity, 3) || !Finite(p.FluidBounds, 6) || !Finite(p.DomainBounds, 6))
+  {
+    fail("Gravity, FluidBounds and DomainBounds must be finite");
+  }
+  if (p.Walls)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      if ((a != 1 || p.Dimension == 3) && !(p.DomainBounds[2 * a + 1] > p.DomainBounds[2 * a]))
+      {
+        fail("DomainBounds must satisfy min < max on every axis of the simulation");
+      }
+    }
+  }
+  if (!(p.BoundarySpacingFactor > 0.0) || p.ReorderInterval < 1 || p.MaximumStepsPerInterval < 1)
+  {
+    fail("invalid internal SPH parameters");
+  }
+  this->Params = p;
+  if (p.Dimension == 2)
+  {
+    this->Params.Gravity[1] = 0.0;
+  }
+  const int d = p.Dimension;
+  const double dx = p.ParticleSpacing;
+  this->H = p.SmoothingLength > 0.0 ? p.SmoothingLength : 2.0 * dx;
+  this->H2 = this->H * this->H;
+  if (this->H < 1.5 * dx || this->H > 6.0 * dx)
+  {
+    std::ostringstream s;
+    s << "SmoothingLength " << this->H << " is " << this->H / dx
+      << " particle spacings; 1.5 to 6 (default 2) keeps neighbour counts sensible";
+    this->WarningList.push_back(s.str());
+  }
+  this->Mass = p.RestDensity * std::pow(dx, d);
+  this->K = p.GasStiffness > 0.0 ? p.GasStiffness : AutoStiffness(p);
+  this->C0 = std::sqrt(this->K);
+  this->TaitB = p.RestDensity * this->K / 7.0;
+  this->Nu = p.Viscosity / p.RestDensity;
+  this->WallMargin = 0.1 * dx;
+
+  // Continuous normalisations (5.27, 5.41, 5.49 in 3D; their 2D counterparts), then the lattice factors.
+  const double h = this->H;
+  const double spikyNorm = d == 3 ? 15.0 / (Pi * std::pow(h, 6)) : 10.0 / (Pi * std::pow(h, 5));
+  this->Poly6 = d == 3 ? 315.0 / (64.0 * Pi * std::pow(h, 9)) : 4.0 / (Pi * std::pow(h, 8));
+  this->ViscLap = d == 3 ? 45.0 / (Pi * std::pow(h, 6)) : 40.0 / (Pi * std::pow(h, 5));
+  this->SpikyDensity = p.Kernels == SPHKernelPair::Spiky;
+  this->SpikyGradient = p.Kernels != SPHKernelPair::Poly6;
+  this->DensityNorm = this->SpikyDensity ? spikyNorm : this->Poly6;
+  this->GradientNorm = this->SpikyGradient ? 3.0 * spikyNorm : 6.0 * this->Poly6;
+  {
+    const int reach = static_cast<int>(std::ceil(h / dx));
+    const double volume = std::pow(dx, d);
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, sc = 0.0;
+    for (int k = -reach; k <= reach; ++k)
+    {
+      for (int j = (d == 3 ? -reach : 0); j <= (d == 3 ? reach : 0); ++j)
+      {
+        for (int i = -reach; i <= reach; ++i)
+        {
+          const double x = i * dx, y = j * dx, z = k * dx;
+          const double r2 = x * x + y * y + z * z;
+          if (!(r2 < this->H2))
+          {
+            continue;
+          }
+          const double r = std::sqrt(r2);
+          s0 += volume * this->DensityNorm * this->DensityShape(r2);
+          sc += volume * this->Poly6 * (this->H2 - r2) * (this->H2 - r2) * (this->H2 - r2);
+          if (r2 > 0.0)
+          {
+            s1 += volume * this->GradientNorm * this->GradientShape(r2, r) * x * x; // sum V (x_j - x_i)_x dW/dx_i
+            s2 += volume * r2 * this->ViscLap * (h - r);
+          }
+        }
+      }
+    }
+    // Density response of the discrete lattice to a uniaxial compression along gravity (1 in the continuum):
+    // the hydrostatic start compresses by the strain that gives the wanted density, not the continuum's.
+    {
+      int axis = 2;
+      for (int a = 0; a < 3; ++a)
+      {
+        axis = std::fabs(this->Params.Gravity[a]) > std::fabs(this->Params.Gravity[axis]) ? a : axis;
+      }
+      const double strain = 1e-3;
+      double compressed = 0.0;
+      for (int k = -reach - 1; k <= reach + 1; ++k)
+      {
+        for (int j = (d == 3 ? -reach - 1 : 0); j <= (d == 3 ? reach + 1 : 0); ++j)
+        {
+          for (int i = -reach - 1; i <= reach + 1; ++i)
+          {
+            double x[3] = { i * dx, j * dx, k * dx };
+            x[axis] *= 1.0 - strain;
+            const double r2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+            if (r2 < this->H2)
+            {
+              compressed += volume * this->DensityNorm * this->DensityShape(r2);
+            }
+          }
+        }
+      }
+      this->CompressionResponse = s0 > 0.0 ? (compressed / s0 - 1.0) / strain : 1.0;
+      if (!(this->CompressionResponse > 0.1))
+      {
+        this->CompressionResponse = 1.0;
+      }
+    }
+    this->DensityCorrection = s0 > 0.0 ? 1.0 / s0 : 1.0;
+    this->GradientCorrection = s1 > 0.0 ? 1.0 / s1 : 1.0;
+    this->ViscCorrection = s2 > 0.0 ? 2.0 * d / s2 : 1.0;
+    this->DensityNorm *= this->DensityCorrection;
+    this->GradientNorm *= this->GradientCorrection;
+    this->ViscLap *= this->ViscCorrection;
+    this->Poly6 *= sc > 0.0 ? 1.0 / sc : 1.0; // colour field
+  }
+
+  // Boundary (dummy) particles: a shell behind the container walls and a layer inside every obstacle, as
+  // thick as the support; obstacle surfaces are also sampled for the crossing test (SPHBoundary.h).
+  const int layers = static_cast<int>(std::ceil(h / dx));
+  this->BoundaryPosition.clear();
+  this->ObstaclePosition.clear();
+  this->ObstacleNormal.clear();
+  if (p.Walls)
+  {
+    BoxWallLayers(p.DomainBounds, d, dx, layers, this->BoundaryPosition);
+  }
+  if (!obstacleTriangles.empty())
+  {
+    const double bs = dx * p.BoundarySpacingFactor;
+    std::vector<double> xyz, normals;
+    SampleTriangles(obstacleTriangles, bs, xyz, normals);
+    for (std::size_t i = 0; i < xyz.size(); i += 3)
+    {
+      if (d == 2)
+      {
+        // 2D: the section of the surface by the plane y = 0, normals projected into it.
+        const double ny = normals[i + 1];
+        const double inPlane = std::sqrt(std::max(0.0, 1.0 - ny * ny));
+        if (std::fabs(xyz[i + 1]) > 0.5 * bs || inPlane < 1e-3)
+        {
+          continue;
+        }
+        this->ObstaclePosition.insert(this->ObstaclePosition.end(), { xyz[i], 0.0, xyz[i + 2] });
+        this->ObstacleNormal.insert(
+          this->ObstacleNormal.end(), { normals[i] / inPlane, 0.0, normals[i + 2] / inPlane });
+      }
+      else
+      {
+        this->ObstaclePosition.insert(this->ObstaclePosition.end(), xyz.begin() + i, xyz.begin() + i + 3);
+        this->ObstacleNormal.insert(this->ObstacleNormal.end(), normals.begin() + i, normals.begin() + i + 3);
+      }
+    }
+    if (this->ObstaclePosition.empty())
+    {
+      this->WarningList.push_back("the Obstacles surface has no usable triangles (in 2D: none crosses y = 0)");
+    }
+  }
+  this->ObstacleGrid.Build(this->ObstaclePosition.data(), static_cast<Index>(this->ObstaclePosition.size() / 3));
+  if (!this->ObstaclePosition.empty())
+  {
+    this->ObstacleGrid.GetBounds(this->ObstacleBox);
+    const double origin[3] = { p.FluidBounds[0], p.FluidBounds[2], p.FluidBounds[4] };
+    ObstacleLayers(this->ObstaclePosition, this->ObstacleNormal, this->ObstacleGrid, origin, dx, h, d,
+      this->BoundaryPosition);
+  }
+  else
+  {
+    this->ObstacleBox[0] = this->ObstacleBox[2] = this->ObstacleBox[4] = 0.0;
+    this->ObstacleBox[1] = this->ObstacleBox[3] = this->ObstacleBox[5] = -1.0;
+  }
+  this->BoundaryCount = static_cast<Index>(this->BoundaryPosition.size() / 3);
+  this->BoundaryGrid.Build(this->BoundaryPosition.data(), this->BoundaryCount, h);
+}
+
+double SPHFluid::PressureOf(double rho) const
+{
+  const double rho0 = this->Params.RestDensity;
+  double pressure;
+  if (this->Params.EquationOfState == SPHEquationOfState::Tait)
+  {
+    const double ratio = rho / rho0;
+    const double r2 = ratio * ratio;
+    pressure = this->TaitB * (r2 * r2 * r2 * ratio - 1.0);
+  }
+  else
+  {
+    pressure = this->K * (rho - rho0);
+  }
+  return pressure > 0.0 ? pressure : 0.0; // clamped: see the header
+}
+
+double SPHFluid::DensityOf(double pressure) const
+{
+  const double rho0 = this->Params.RestDensity;
+  if (this->Params.EquationOfState == SPHEquationOfState::Tait)
+  {
+    return rho0 * std::pow(1.0 + pressure / this->TaitB, 1.0 / 7.0);
+  }
+  return rho0 + pressure / this->K;
+}
+
+bool SPHFluid::NearBoundary(const double* x) const
+{
+  const SPHParameters& p = this->Params;
+  const double h = this->H;
+  if (p.Walls)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      if (a == 1 && p.Dimension == 2)
+      {
+        continue;
+      }
+      if (x[a] - p.DomainBounds[2 * a] < h || p.DomainBounds[2 * a + 1] - x[a] < h)
+      {
+        return true;
+      }
+    }
+  }
+  return this->NearObstacle(x);
+}
+
+bool SPHFluid::NearObstacle(const double* x) const
+{
+  const double h = this->H;
+  const double* o = this->ObstacleBox;
+  return x[0] > o[0] - h && x[0] < o[1] + h && x[1] > o[2] - h && x[1] < o[3] + h && x[2] > o[4] - h &&
+    x[2] < o[5] + h;
+}
+
+SPHState SPHFluid::InitialState()
+{
+  const SPHParameters& p = this->Params;
+  const double dx = p.ParticleSpacing;
+  SPHState state;
+  Index count[3];
+  double total = 1.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    count[a] = (a == 1 && p.Dimension == 2) ? 1 : LatticeCount(p.FluidBounds[2 * a], p.FluidBounds[2 * a + 1], dx);
+    total *= static_cast<double>(count[a]);
+  }
+  if (total > static_cast<double>(MaximumParticles))
+  {
+    std::ostringstream s;
+    s << "FluidBounds / ParticleSpacing would create " << total << " particles (more than " << MaximumParticles
+      << ")";
+    throw std::invalid_argument(s.str());
+  }
+  if (total == 0.0)
+  {
+    this->WarningList.push_back("FluidBounds hold no lattice node of ParticleSpacing: the fluid has no particles");
+  }
+  Index outside = 0;
+  std::vector<Index> nearest(1);
+  std::vector<double> nearestD2(1);
+  for (Index k = 0; k < count[2]; ++k)
+  {
+    for (Index j = 0; j < count[1]; ++j)
+    {
+      for (Index i = 0; i < count[0]; ++i)
+      {
+        const double x[3] = { p.FluidBounds[0] + (i + 0.5) * dx,
+          p.Dimension == 2 ? 0.0 : p.FluidBounds[2] + (j + 0.5) * dx, p.FluidBounds[4] + (k + 0.5) * dx };
+        bool keep = true;
+        for (int a = 0; a < 3 && p.Walls; ++a)
+        {
+          if (!(a == 1 && p.Dimension == 2) &&
+            (x[a] < p.DomainBounds[2 * a] + this->WallMargin || x[a] > p.DomainBounds[2 * a + 1] - this->WallMargin))
+          {
+            keep = false;
+          }
+        }
+        if (keep && !this->ObstaclePosition.empty() && this->ObstacleGrid.FindKNearest(x, 1, nearest, nearestD2) == 1)
+        {
+          const double* s = &this->ObstaclePosition[3 * nearest[0]];
+          const double* n = &this->ObstacleNormal[3 * nearest[0]];
+          keep = (x[0] - s[0]) * n[0] + (x[1] - s[1]) * n[1] + (x[2] - s[2]) * n[2] > 0.5 * dx;
+        }
+        if (!keep)
+        {
+          ++outside;
+          continue;
+        }
+        state.Position.insert(state.Position.end(), x, x + 3);
+        state.Id.push_back(static_cast<std::int64_t>(state.Id.size()));
+      }
+    }
+  }
+  if (outside > 0)
+  {
+    std::ostringstream s;
+    s << outside << " of " << static_cast<Index>(total)
+      << " particles of FluidBounds lie outside DomainBounds or inside an obstacle and were left out";
+    this->WarningList.push_back(s.str());
+  }
+  const Index n = state.Size();
+  // Hydrostatic start: the block is compressed along gravity as a column at rest would be (what a tank holds
+  // before its gate opens), so that the release does not begin with a pressure wave. Linearised EOS:
+  // rho(s) = rho0 (1 + g s / k) at depth s, and mass conservation maps depth d to d' with d' + g d'^2/(2k) = d.
+  const double* g = p.Gravity;
+  const double gNorm = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+  if (gNorm > 0.0 && n > 0)
+  {
+    const double up[3] = { -g[0] / gNorm, -g[1] / gNorm, -g[2] / gNorm };
+    double top = -std::numeric_limits<double>::max();
+    for (int corner = 0; corner < 8; ++corner)
+    {
+      const double c[3] = { p.FluidBounds[corner & 1], p.FluidBounds[2 + ((corner >> 1) & 1)],
+        p.FluidBounds[4 + ((corner >> 2) & 1)] };
+      top = std::max(top, c[0] * up[0] + c[1] * up[1] + c[2] * up[2]);
+    }
+    const double ratio = gNorm / (this->K * this->CompressionResponse);
+    auto compress = [ratio](double depth) {
+      return ratio > 0.0 ? 2.0 * depth / (std::sqrt(1.0 + 2.0 * ratio * depth) + 1.0) : depth;
+    };
+    double deepest = 0.0;
+    for (Index i = 0; i < n; ++i)
+    {
+      const double* x = &state.Position[3 * i];
+      deepest = std::max(deepest, top - (x[0] * up[0] + x[1] * up[1] + x[2] * up[2]));
+    }
+    const double settle = deepest - compress(deepest); // the deepest particles keep their place
+    for (Index i = 0; i < n; ++i)
+    {
+      double* x = &state.Position[3 * i];
+      const double depth = top - (x[0] * up[0] + x[1] * up[1] + x[2] * up[2]);
+      const double shift = (depth - compress(depth)) - settle; // <= 0: towards the bottom
+      for (int a = 0; a < 3; ++a)
+      {
+        x[a] += shift * up[a];
+      }
+    }
+  }
+  state.Velocity.assign(3 * n, 0.0);
+  state.Acceleration.assign(3 * n, 0.0);
+  state.Density.assign(n, p.RestDensity);
+  state.Pressure.assign(n, 0.0);
+  this->ComputeAccelerations(state);
+  return state;
+}
+
+} // namespace meshfree

@@ -1,0 +1,339 @@
+#include "vtkMeshFreeSPHFluid.h"
+
+#include "vtkCellArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "SPHFluid.h"
+#include "StateCache.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkMeshFreeSPHFluid);
+
+struct vtkMeshFreeSPHFluid::Internals
+{
+  meshfree::SPHFluid Solver;
+  meshfree::StateCache<meshfree::SPHState> Cache{ 16 };
+  std::string Key;         // everything the cached states depend on; a different key empties the cache
+  bool SetupFailed = false;
+  std::vector<double> Times;
+};
+
+vtkMeshFreeSPHFluid::vtkMeshFreeSPHFluid()
+  : Impl(new Internals)
+{
+  this->SetNumberOfInputPorts(1);
+}
+
+vtkMeshFreeSPHFluid::~vtkMeshFreeSPHFluid() = default;
+
+int vtkMeshFreeSPHFluid::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  return 1;
+}
+
+namespace
+{
+// Output times 0, interval, ..., end (the last one is `end` itself when it is not a multiple).
+std::vector<double> OutputTimes(double end, double interval)
+{
+  std::vector<double> times{ 0.0 };
+  if (!(interval > 0.0) || !(end > 0.0) || !std::isfinite(end) || !std::isfinite(interval))
+  {
+    return times;
+  }
+  const double count = std::min(std::ceil(end / interval - 1e-9), 1e6);
+  for (long k = 1; k <= static_cast<long>(count); ++k)
+  {
+    times.push_back(std::min(k * interval, end));
+  }
+  return times;
+}
+
+// Triangles of the polygons and strips of `surface`, 9 doubles each (fan triangulation of polygons).
+std::vector<double> Triangles(vtkPolyData* surface)
+{
+  std::vector<double> out;
+  if (!surface || surface->GetNumberOfPoints() == 0)
+  {
+    return out;
+  }
+  auto add = [&](vtkIdType a, vtkIdType b, vtkIdType c) {
+    double p[3];
+    for (vtkIdType id : { a, b, c })
+    {
+      surface->GetPoint(id, p);
+      out.insert(out.end(), p, p + 3);
+    }
+  };
+  vtkIdType n;
+  const vtkIdType* ids;
+  vtkCellArray* polys = surface->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(n, ids);)
+  {
+    for (vtkIdType k = 1; k + 1 < n; ++k)
+    {
+      add(ids[0], ids[k], ids[k + 1]);
+    }
+  }
+  vtkCellArray* strips = surface->GetStrips();
+  for (strips->InitTraversal(); strips->GetNextCell(n, ids);)
+  {
+    for (vtkIdType k = 0; k + 2 < n; ++k)
+    {
+      k % 2 == 0 ? add(ids[k], ids[k + 1], ids[k + 2]) : add(ids[k + 1], ids[k], ids[k + 2]);
+    }
+  }
+  return out;
+}
+}
+
+int vtkMeshFreeSPHFluid::GetNumberOfOutputTimes()
+{
+  return static_cast<int>(OutputTimes(this->EndTime, this->OutputInterval).size());
+}
+
+int vtkMeshFreeSPHFluid::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  if (!(this->OutputInterval > 0.0) || !(this->EndTime >= 0.0))
+  {
+    vtkErrorMacro("OutputInterval must be > 0 and EndTime >= 0 (got " << this->OutputInterval << ", "
+                                                                      << this->EndTime << ")");
+  }
+  this->Impl->Times = OutputTimes(this->EndTime, this->OutputInterval);
+  const std::vector<double>& times = this->Impl->Times;
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
+  const double range[2] = { times.front(), times.back() };
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  return 1;
+}
+
+int vtkMeshFreeSPHFluid::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPolyData* output = vtkPolyData::GetData(outputVector);
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  Internals& impl = *this->Impl;
+  if (impl.Times.empty())
+  {
+    impl.Times = OutputTimes(this->EndTime, this->OutputInterval);
+  }
+
+  // Snap the requested time to the nearest output time.
+  const std::vector<double>& times = impl.Times;
+  double requested = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+    : 0.0;
+  long step = 0;
+  for (long k = 1; k < static_cast<long>(times.size()); ++k)
+  {
+    if (std::fabs(times[k] - requested) < std::fabs(times[step] - requested))
+    {
+      step = k;
+    }
+  }
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), times[step]);
+
+  meshfree::SPHParameters p;
+  p.Dimension = this->Dimension;
+  std::copy(this->FluidBounds, this->FluidBounds + 6, p.FluidBounds);
+  std::copy(this->DomainBounds, this->DomainBounds + 6, p.DomainBounds);
+  p.ParticleSpacing = this->ParticleSpacing;
+  p.SmoothingLength = this->SmoothingLength;
+  p.RestDensity = this->RestDensity;
+  p.GasStiffness = this->GasStiffness;
+  p.EquationOfState = static_cast<meshfree::SPHEquationOfState>(this->EquationOfState);
+  p.Kernels = static_cast<meshfree::SPHKernelPair>(this->KernelPair);
+  p.Viscosity = this->Viscosity;
+  p.SurfaceTension = this->SurfaceTension;
+  std::copy(this->Gravity, this->Gravity + 3, p.Gravity);
+  p.TimeStep = this->TimeStep;
+  p.CFLNumber = this->CFLNumber;
+
+  vtkPolyData* obstacles = vtkPolyData::GetData(inputVector[0], 0);
+  std::ostringstream key;
+  key << std::hexfloat << p.Dimension << ' ' << p.ParticleSpacing << ' ' << p.SmoothingLength << ' '
+      << p.RestDensity << ' ' << p.GasStiffness << ' ' << this->EquationOfState << ' ' << this->KernelPair << ' '
+      << p.Viscosity << ' ' << p.SurfaceTension << ' ' << p.TimeStep << ' ' << p.CFLNumber << ' '
+      << this->OutputInterval << ' ' << (obstacles ? static_cast<long>(obstacles->GetMTime()) : -1L);
+  for (int i = 0; i < 6; ++i)
+  {
+    key << ' ' << p.FluidBounds[i] << ' ' << p.DomainBounds[i] << ' ' << (i < 3 ? p.Gravity[i] : 0.0);
+  }
+  impl.Cache.SetCapacity(static_cast<std::size_t>(this->CacheSize));
+  if (key.str() != impl.Key)
+  {
+    impl.Key = key.str();
+    impl.Cache.Clear();
+    impl.SetupFailed = false;
+    try
+    {
+      impl.Solver.Setup(p, Triangles(obstacles));
+      meshfree::SPHState initial = impl.Solver.InitialState();
+      impl.Cache.Insert(0, std::move(initial));
+    }
+    catch (const std::exception& e)
+    {
+      vtkErrorMacro("SPH Fluid: " << e.what());
+      impl.SetupFailed = true;
+    }
+    for (const std::string& warning : impl.Solver.Warnings())
+    {
+      vtkWarningMacro("SPH Fluid: " << warning);
+    }
+  }
+  if (impl.SetupFailed)
+  {
+    return 1; // empty output, the error has been reported
+  }
+
+  // Restore the nearest earlier cached state and simulate forward, caching every output time reached.
+  long found = 0;
+  const meshfree::SPHState* cached = impl.Cache.FindAtOrBefore(step, found);
+  meshfree::SPHState state = *cached;
+  const long reducedBefore = impl.Solver.ReducedSteps();
+  for (long k = found + 1; k <= step; ++k)
+  {
+    const long stepsBefore = state.Steps;
+    const double span = static_cast<double>(step - found);
+    const auto progress = [this, k, found, span](double fraction) {
+      this->UpdateProgress((static_cast<double>(k - found - 1) + fraction) / span);
+      return !this->GetAbortExecute();
+    };
+    const meshfree::SPHFluid::Status status = impl.Solver.Advance(state, times[k], progress);
+    this->StepsTaken += state.Steps - stepsBefore;
+    if (status == meshfree::SPHFluid::Status::Aborted)
+    {
+      vtkWarningMacro("SPH Fluid: aborted at t = " << state.Time << "; the output is empty");
+      return 1;
+    }
+    if (status == meshfree::SPHFluid::Status::Failed)
+    {
+      vtkErrorMacro("SPH Fluid: " << impl.Solver.ErrorMessage() << "; the output is empty");
+      return 1;
+    }
+    impl.Cache.Insert(k, state);
+  }
+  if (impl.Solver.ReducedSteps() > reducedBefore)
+  {
+    vtkWarningMacro("SPH Fluid: TimeStep " << this->TimeStep << " s exceeds the stability limit; it was reduced on "
+                                           << impl.Solver.ReducedSteps() - reducedBefore
+                                           << " steps (set CFLNumber > 0 for adaptive steps)");
+  }
+
+  // Output: one vertex per particle.
+  const vtkIdType n = static_cast<vtkIdType>(state.Size());
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  vtkNew<vtkDoubleArray> velocity, density, pressure, acceleration;
+  velocity->SetName("Velocity");
+  velocity->SetNumberOfComponents(3);
+  velocity->SetNumberOfTuples(n);
+  density->SetName("Density");
+  density->SetNumberOfTuples(n);
+  pressure->SetName("Pressure");
+  pressure->SetNumberOfTuples(n);
+  vtkNew<vtkIdTypeArray> ids;
+  ids->SetName("Id");
+  ids->SetNumberOfTuples(n);
+  vtkNew<vtkIdTypeArray> connectivity;
+  connectivity->SetNumberOfTuples(n);
+  vtkNew<vtkIdTypeArray> offsets;
+  offsets->SetNumberOfTuples(n + 1);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    points->SetPoint(i, &state.Position[3 * i]);
+    velocity->SetTypedTuple(i, &state.Velocity[3 * i]);
+    density->SetValue(i, state.Density[i]);
+    pressure->SetValue(i, state.Pressure[i]);
+    ids->SetValue(i, static_cast<vtkIdType>(state.Id[i]));
+    connectivity->SetValue(i, i);
+    offsets->SetValue(i, i);
+  }
+  offsets->SetValue(n, n);
+  vtkNew<vtkCellArray> verts;
+  verts->SetData(offsets, connectivity);
+  output->SetPoints(points);
+  output->SetVerts(verts);
+  vtkPointData* pd = output->GetPointData();
+  pd->AddArray(velocity);
+  pd->AddArray(density);
+  pd->AddArray(pressure);
+  pd->AddArray(ids);
+  if (this->ComputeAcceleration)
+  {
+    acceleration->SetName("Acceleration");
+    acceleration->SetNumberOfComponents(3);
+    acceleration->SetNumberOfTuples(n);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      acceleration->SetTypedTuple(i, &state.Acceleration[3 * i]);
+    }
+    pd->AddArray(acceleration);
+  }
+  if (this->ComputeNeighborCount)
+  {
+    const std::vector<int> counts = impl.Solver.NeighborCounts(state);
+    vtkNew<vtkIntArray> neighbors;
+    neighbors->SetName("NeighborCount");
+    neighbors->SetNumberOfTuples(n);
+    std::copy(counts.begin(), counts.end(), neighbors->GetPointer(0));
+    pd->AddArray(neighbors);
+  }
+  pd->SetActiveScalars("Pressure");
+  return 1;
+}
+
+void vtkMeshFreeSPHFluid::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FluidBounds: ";
+  for (double b : this->FluidBounds)
+  {
+    os << b << " ";
+  }
+  os << "\n" << indent << "DomainBounds: ";
+  for (double b : this->DomainBounds)
+  {
+    os << b << " ";
+  }
+  os << "\n";
+  os << indent << "Dimension: " << this->Dimension << "\n";
+  os << indent << "ParticleSpacing: " << this->ParticleSpacing << "\n";
+  os << indent << "SmoothingLength: " << this->SmoothingLength << "\n";
+  os << indent << "RestDensity: " << this->RestDensity << "\n";
+  os << indent << "GasStiffness: " << this->GasStiffness << "\n";
+  os << indent << "EquationOfState: " << this->EquationOfState << "\n";
+  os << indent << "KernelPair: " << this->KernelPair << "\n";
+  os << indent << "Viscosity: " << this->Viscosity << "\n";
+  os << indent << "SurfaceTension: " << this->SurfaceTension << "\n";
+  os << indent << "Gravity: " << this->Gravity[0] << " " << this->Gravity[1] << " " << this->Gravity[2] << "\n";
+  os << indent << "TimeStep: " << this->TimeStep << "\n";
+  os << indent << "CFLNumber: " << this->CFLNumber << "\n";
+  os << indent << "EndTime: " << this->EndTime << "\n";
+  os << indent << "OutputInterval: " << this->OutputInterval << "\n";
+  os << indent << "ComputeAcceleration: " << this->ComputeAcceleration << "\n";
+  os << indent << "ComputeNeighborCount: " << this->ComputeNeighborCount << "\n";
+  os << indent << "CacheSize: " << this->CacheSize << "\n";
+}

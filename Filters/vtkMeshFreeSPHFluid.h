@@ -1,0 +1,191 @@
+/**
+ * @class   vtkMeshFreeSPHFluid
+ * @brief   time-dependent SPH fluid source (Müller, Charypar & Gross 2003; thesis ch. 5)
+ *
+ * Fills `FluidBounds` with particles on a lattice of `ParticleSpacing` (mass `RestDensity`·spacing^dim) inside
+ * the closed container `DomainBounds` and simulates them with the VTK-free core (meshfree::SPHFluid, see
+ * Filters/Core/SPHFluid.h for the model, kernels, walls and time stepping). `Dimension` 2 simulates the x–z plane.
+ *
+ * Time: the source reports the time steps 0, OutputInterval, …, EndTime; a requested time is snapped to the
+ * nearest of them and the output is the state at exactly that time. Simulated states are kept in a bounded
+ * cache (`CacheSize` states, meshfree::StateCache): a request restores the nearest earlier cached state and
+ * simulates forward from there, so revisiting a time or stepping backwards never restarts from t = 0. Any change
+ * of a property that affects the simulation, or of the `Obstacles` input, empties the cache.
+ *
+ * Optional input port 0, `Obstacles`: closed polygonal surfaces (polygons and triangle strips are triangulated)
+ * that the fluid flows around.
+ *
+ * Output: vtkPolyData, one vertex per particle, point arrays `Velocity` (3), `Density`, `Pressure`, `Id`
+ * (stable across time), and on request `Acceleration` (3) and `NeighborCount`.
+ */
+#ifndef vtkMeshFreeSPHFluid_h
+#define vtkMeshFreeSPHFluid_h
+
+#include "MeshFreeFiltersModule.h"
+#include "vtkPolyDataAlgorithm.h"
+
+#include <memory>
+
+class MESHFREEFILTERS_EXPORT vtkMeshFreeSPHFluid : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkMeshFreeSPHFluid* New();
+  vtkTypeMacro(vtkMeshFreeSPHFluid, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /** Initial block of fluid [x0,x1,y0,y1,z0,z1], filled on the lattice of ParticleSpacing. */
+  vtkSetVector6Macro(FluidBounds, double);
+  vtkGetVector6Macro(FluidBounds, double);
+  ///@}
+
+  ///@{
+  /** The closed container [x0,x1,y0,y1,z0,z1]: walls on every side. */
+  vtkSetVector6Macro(DomainBounds, double);
+  vtkGetVector6Macro(DomainBounds, double);
+  ///@}
+
+  ///@{
+  /** 3 (default) or 2: the x–z plane (y ignored, gravity on z). */
+  vtkSetClampMacro(Dimension, int, 2, 3);
+  vtkGetMacro(Dimension, int);
+  ///@}
+
+  ///@{
+  /** Lattice spacing of the initial particles (m). Default 0.02. */
+  vtkSetMacro(ParticleSpacing, double);
+  vtkGetMacro(ParticleSpacing, double);
+  ///@}
+
+  ///@{
+  /** Kernel support radius h (m); 0 (default): 2·ParticleSpacing. */
+  vtkSetMacro(SmoothingLength, double);
+  vtkGetMacro(SmoothingLength, double);
+  ///@}
+
+  ///@{
+  /** ρ0 (kg/m³). Default 1000. */
+  vtkSetMacro(RestDensity, double);
+  vtkGetMacro(RestDensity, double);
+  ///@}
+
+  ///@{
+  /** k (m²/s²): Ideal p = k(ρ − ρ0); Tait B = ρ0 k / 7 (k = c0²). 0 (default): 100 g H (≤ 1 % compression). */
+  vtkSetMacro(GasStiffness, double);
+  vtkGetMacro(GasStiffness, double);
+  ///@}
+
+  ///@{
+  /** 0: 'Ideal' p = k(ρ − ρ0) (thesis 5.40, default); 1: 'Tait' (γ = 7). */
+  vtkSetClampMacro(EquationOfState, int, 0, 1);
+  vtkGetMacro(EquationOfState, int);
+  ///@}
+
+  ///@{
+  /** Kernels of density and pressure force: 0 'Spiky' (default), 1 'Poly6', 2 'Mueller' (see SPHFluid.h). */
+  vtkSetClampMacro(KernelPair, int, 0, 2);
+  vtkGetMacro(KernelPair, int);
+  ///@}
+
+  ///@{
+  /** Dynamic viscosity μ (Pa·s). Default 0.01. */
+  vtkSetMacro(Viscosity, double);
+  vtkGetMacro(Viscosity, double);
+  ///@}
+
+  ///@{
+  /** Surface tension σ (N/m). Default 0. */
+  vtkSetMacro(SurfaceTension, double);
+  vtkGetMacro(SurfaceTension, double);
+  ///@}
+
+  ///@{
+  /** Gravity (m/s²). Default (0, 0, −9.81). */
+  vtkSetVector3Macro(Gravity, double);
+  vtkGetVector3Macro(Gravity, double);
+  ///@}
+
+  ///@{
+  /** Largest time step (s). Default 0.002. */
+  vtkSetMacro(TimeStep, double);
+  vtkGetMacro(TimeStep, double);
+  ///@}
+
+  ///@{
+  /** CFL factor λ of the adaptive step; 0: fixed TimeStep (reduced, with a warning, when unstable). Default 0.25. */
+  vtkSetMacro(CFLNumber, double);
+  vtkGetMacro(CFLNumber, double);
+  ///@}
+
+  ///@{
+  /** Last reported time (s). Default 1. */
+  vtkSetMacro(EndTime, double);
+  vtkGetMacro(EndTime, double);
+  ///@}
+
+  ///@{
+  /** Interval between reported times (s). Default 0.02. */
+  vtkSetMacro(OutputInterval, double);
+  vtkGetMacro(OutputInterval, double);
+  ///@}
+
+  ///@{
+  /** Extra output arrays: `Acceleration` and `NeighborCount`. Default off. */
+  vtkSetMacro(ComputeAcceleration, bool);
+  vtkGetMacro(ComputeAcceleration, bool);
+  vtkBooleanMacro(ComputeAcceleration, bool);
+  vtkSetMacro(ComputeNeighborCount, bool);
+  vtkGetMacro(ComputeNeighborCount, bool);
+  vtkBooleanMacro(ComputeNeighborCount, bool);
+  ///@}
+
+  ///@{
+  /** Number of simulation states kept in the time cache (≥ 2). Default 16. */
+  vtkSetClampMacro(CacheSize, int, 2, 100000);
+  vtkGetMacro(CacheSize, int);
+  ///@}
+
+  /** Number of simulation steps taken by this object since its creation (for tests of the cache). */
+  vtkGetMacro(StepsTaken, long);
+
+  /** The output times reported by RequestInformation (for tests). */
+  int GetNumberOfOutputTimes();
+
+protected:
+  vtkMeshFreeSPHFluid();
+  ~vtkMeshFreeSPHFluid() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  double FluidBounds[6] = { 0.0, 0.2, 0.0, 0.2, 0.0, 0.4 };
+  double DomainBounds[6] = { 0.0, 0.8, 0.0, 0.2, 0.0, 0.5 };
+  int Dimension = 3;
+  double ParticleSpacing = 0.02;
+  double SmoothingLength = 0.0;
+  double RestDensity = 1000.0;
+  double GasStiffness = 0.0;
+  int EquationOfState = 0;
+  int KernelPair = 0;
+  double Viscosity = 0.01;
+  double SurfaceTension = 0.0;
+  double Gravity[3] = { 0.0, 0.0, -9.81 };
+  double TimeStep = 0.002;
+  double CFLNumber = 0.25;
+  double EndTime = 1.0;
+  double OutputInterval = 0.02;
+  bool ComputeAcceleration = false;
+  bool ComputeNeighborCount = false;
+  int CacheSize = 16;
+  long StepsTaken = 0;
+
+private:
+  vtkMeshFreeSPHFluid(const vtkMeshFreeSPHFluid&) = delete;
+  void operator=(const vtkMeshFreeSPHFluid&) = delete;
+
+  struct Internals;
+  std::unique_ptr<Internals> Impl;
+};
+
+#endif
