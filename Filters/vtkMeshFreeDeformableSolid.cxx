@@ -1,0 +1,480 @@
+#include "vtkMeshFreeDeformableSolid.h"
+
+#include "vtkCellArray.h"
+#include "vtkCompositeDataSet.h"
+#include "vtkDoubleArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkMultiBlockDataSet.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "ElasticShapes.h"
+#include "ElasticSolid.h"
+#include "StateCache.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkMeshFreeDeformableSolid);
+
+struct vtkMeshFreeDeformableSolid::Internals
+{
+  meshfree::ElasticSolid Solid;
+  meshfree::ElasticSurface Surface;
+  std::vector<double> SurfacePoints; // rest positions of the surface vertices
+  std::vector<meshfree::Index> Triangles;
+  meshfree::StateCache<meshfree::ElasticState> Cache{ 16 };
+  vtkTimeStamp BuildTime;
+  bool Valid = false;    // the model was built without error
+  bool BuiltWithInput = false;
+  bool Unstable = false; // the simulation blew up: later steps repeat the last finite state
+};
+
+vtkMeshFreeDeformableSolid::vtkMeshFreeDeformableSolid()
+  : Impl(new Internals)
+{
+  this->SetNumberOfInputPorts(1);
+}
+
+vtkMeshFreeDeformableSolid::~vtkMeshFreeDeformableSolid() = default;
+
+int vtkMeshFreeDeformableSolid::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  return 1;
+}
+
+namespace
+{
+// 0, OutputInterval, 2 OutputInterval, ..., and EndTime itself when it is not a multiple.
+std::vector<double> OutputTimes(double endTime, double interval)
+{
+  std::vector<double> times{ 0.0 };
+  if (!(endTime > 0.0) || !(interval > 0.0) || !std::isfinite(endTime) || !std::isfinite(interval))
+  {
+    return times;
+  }
+  const long count = std::min(1000000L, static_cast<long>(std::floor(endTime / interval + 1e-9)));
+  for (long k = 1; k <= count; ++k)
+  {
+    times.push_back(k * interval);
+  }
+  if (endTime - times.back() > 1e-9 * endTime && times.size() < 1000001)
+  {
+    times.push_back(endTime);
+  }
+  return times;
+}
+
+bool Finite(const std::vector<double>& values)
+{
+  for (double v : values)
+  {
+    if (!std::isfinite(v))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+vtkSmartPointer<vtkDoubleArray> MakeArray(const char* name, int components, vtkIdType tuples, const double* data)
+{
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(name);
+  array->SetNumberOfComponents(components);
+  array->SetNumberOfTuples(tuples);
+  std::copy(data, data + components * tuples, array->GetPointer(0));
+  return array;
+}
+} // namespace
+
+int vtkMeshFreeDeformableSolid::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  const std::vector<double> times = OutputTimes(this->EndTime, this->OutputInterval);
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
+  const double range[2] = { times.front(), times.back() };
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  return 1;
+}
+
+bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
+{
+  Internals& impl = *this->Impl;
+  impl.Valid = false;
+  impl.Unstable = false;
+  impl.Cache.Clear();
+  impl.Cache.SetCapacity(static_cast<size_t>(this->CacheSize));
+  impl.SurfacePoints.clear();
+  impl.Triangles.clear();
+  this->NumberOfPhyxels = 0;
+  this->StableTimeStep = 0.0;
+
+  if (!(this->PhyxelSpacing > 0.0) || !std::isfinite(this->PhyxelSpacing))
+  {
+    vtkErrorMacro("PhyxelSpacing must be a positive number, not " << this->PhyxelSpacing << ".");
+    return false;
+  }
+  if (!(this->OutputInterval > 0.0) || !(this->EndTime >= 0.0))
+  {
+    vtkErrorMacro("OutputInterval must be positive and EndTime non-negative.");
+    return false;
+  }
+
+  // Phyxels and surface: the input's closed surface, or a built-in shape.
+  std::vector<double> rest;
+  double volume = 0.0;
+  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
+  const auto tooMany = static_cast<meshfree::Index>(5e7);
+  if (input && input->GetNumberOfPoints() > 0)
+  {
+    vtkCellArray* polys = input->GetPolys();
+    impl.SurfacePoints.resize(3 * input->GetNumberOfPoints());
+    for (vtkIdType p = 0; p < input->GetNumberOfPoints(); ++p)
+    {
+      input->GetPoint(p, &impl.SurfacePoints[3 * p]);
+    }
+    const vtkIdType* ids = nullptr;
+    vtkIdType count = 0;
+    for (polys->InitTraversal(); polys->GetNextCell(count, ids);)
+    {
+      for (vtkIdType t = 1; t + 1 < count; ++t) // fan triangulation of polygons
+      {
+        impl.Triangles.insert(impl.Triangles.end(), { ids[0], ids[t], ids[t + 1] });
+      }
+    }
+    volume = std::fabs(meshfree::MeshVolume(impl.SurfacePoints, impl.Triangles));
+    if (impl.Triangles.empty() || !(volume > 0.0))
+    {
+      vtkErrorMacro("The input must be a closed surface made of polygons (it encloses no volume).");
+      impl.SurfacePoints.clear();
+      impl.Triangles.clear();
+      return false;
+    }
+    double b[6];
+    input->GetBounds(b);
+    std::vector<double> lattice;
+    if (!meshfree::SampleLattice(b, this->PhyxelSpacing, [](const double*) { return true; }, lattice, tooMany))
+    {
+      vtkErrorMacro("PhyxelSpacing " << this->PhyxelSpacing << " is too small for the input's size.");
+      return false;
+    }
+    std::vector<char> inside;
+    meshfree::InsideMesh(impl.SurfacePoints, impl.Triangles, lattice, inside);
+    for (size_t q = 0; q < inside.size(); ++q)
+    {
+      if (inside[q])
+      {
+        rest.insert(rest.end(), &lattice[3 * q], &lattice[3 * q] + 3);
+      }
+    }
+  }
+  else
+  {
+    const auto shape = static_cast<meshfree::ElasticShape>(this->Shape);
+    const double* b = this->ShapeBounds;
+    if (!meshfree::SampleLattice(b, this->PhyxelSpacing,
+          [shape, b](const double* p) { return meshfree::InsideShape(shape, b, p); }, rest, tooMany))
+    {
+      vtkErrorMacro("PhyxelSpacing " << this->PhyxelSpacing << " is too small for ShapeBounds.");
+      return false;
+    }
+    volume = meshfree::ShapeVolume(shape, b);
+    if (volume > 0.0)
+    {
+      meshfree::ShapeSurface(shape, b, this->SurfaceResolution, impl.SurfacePoints, impl.Triangles);
+    }
+  }
+  if (rest.empty())
+  {
+    vtkErrorMacro("No phyxels: no lattice point of spacing " << this->PhyxelSpacing
+                                                           << " lies inside the shape. Reduce PhyxelSpacing.");
+    impl.SurfacePoints.clear();
+    impl.Triangles.clear();
+    return false;
+  }
+
+  meshfree::ElasticSettings s;
+  s.YoungModulus = this->YoungModulus;
+  s.PoissonRatio = this->PoissonRatio;
+  s.Density = this->Density;
+  s.VolumeStiffness = this->VolumeStiffness;
+  s.NeighborCount = this->NeighborCount;
+  s.SupportScale = this->SupportScale;
+  s.Kernel = static_cast<meshfree::KernelType>(this->WeightFunction);
+  s.GradientBasis = this->GradientBasis;
+  s.HourglassStiffness = this->HourglassStiffness;
+  s.PlasticYield = this->PlasticYield;
+  s.PlasticCreep = this->PlasticCreep;
+  s.PlasticMaxStrain = this->PlasticMaxStrain;
+  s.Damping = this->Damping;
+  s.Restitution = this->Restitution;
+  s.Friction = this->Friction;
+  s.Contacts = this->SelfContact != 0;
+  s.Container = static_cast<meshfree::ElasticContainer>(this->Container);
+  for (int a = 0; a < 6; ++a)
+  {
+    s.ContainerBounds[a] = this->ContainerBounds[a];
+    s.FixedBounds[a] = this->FixedBounds[a];
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    s.Gravity[a] = std::isfinite(this->Gravity[a]) ? this->Gravity[a] : 0.0;
+  }
+  std::string message;
+  if (!impl.Solid.Initialize(rest, volume, s, message))
+  {
+    vtkErrorMacro("" << message);
+    impl.SurfacePoints.clear();
+    impl.Triangles.clear();
+    return false;
+  }
+  if (!message.empty())
+  {
+    vtkWarningMacro("" << message);
+  }
+  double v0[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    v0[a] = std::isfinite(this->InitialVelocity[a]) ? this->InitialVelocity[a] : 0.0;
+  }
+  impl.Solid.Reset(v0);
+  if (!impl.Triangles.empty())
+  {
+    impl.Surface.Bind(impl.Solid, impl.SurfacePoints);
+  }
+  this->NumberOfPhyxels = static_cast<int>(impl.Solid.Size());
+  this->StableTimeStep = impl.Solid.StableTimeStep();
+  if (this->Integrator == SYMPLECTIC_EULER && this->TimeStep > this->StableTimeStep)
+  {
+    vtkWarningMacro("TimeStep " << this->TimeStep << " s exceeds the stable symplectic Euler step "
+                                << this->StableTimeStep
+                                << " s of this material and sampling: each step is split into "
+                                << std::ceil(this->TimeStep / this->StableTimeStep)
+                                << " sub-steps. Use the Implicit integrator for larger steps.");
+  }
+  impl.Cache.Insert(0, impl.Solid.State());
+  impl.Valid = true;
+  return true;
+}
+
+int vtkMeshFreeDeformableSolid::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  Internals& impl = *this->Impl;
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector);
+  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
+  const bool hasInput = input && input->GetNumberOfPoints() > 0;
+  if (this->GetMTime() > impl.BuildTime || (input && input->GetMTime() > impl.BuildTime) ||
+    hasInput != impl.BuiltWithInput)
+  {
+    this->BuildModel(inputVector);
+    impl.BuiltWithInput = hasInput;
+    impl.BuildTime.Modified();
+  }
+  this->SimulatedSteps = 0;
+
+  // The requested output step: the reported time nearest to the requested one.
+  const std::vector<double> times = OutputTimes(this->EndTime, this->OutputInterval);
+  long step = 0;
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+  {
+    const double t = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    const auto it = std::lower_bound(times.begin(), times.end(), t);
+    step = static_cast<long>(it - times.begin());
+    if (step >= static_cast<long>(times.size()) || (step > 0 && t - times[step - 1] < times[step] - t))
+    {
+      --step;
+    }
+  }
+  output->SetNumberOfBlocks(impl.SurfacePoints.empty() ? 1 : 2);
+  vtkNew<vtkPolyData> phyxels;
+  output->SetBlock(0, phyxels);
+  output->GetMetaData(0u)->Set(vtkCompositeDataSet::NAME(), "Phyxels");
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), times[step]);
+  if (!impl.Valid)
+  {
+    return 1; // the error was reported by BuildModel; an empty "Phyxels" block is the defined result
+  }
+
+  // Restore the nearest checkpoint at or before the requested step and simulate forward, checkpointing.
+  long found = 0;
+  const meshfree::ElasticState* start = impl.Cache.FindAtOrBefore(step, found);
+  if (!start)
+  {
+    vtkErrorMacro("Internal error: the state cache lost its initial state.");
+    return 0;
+  }
+  impl.Solid.State() = *start;
+  const bool implicit = this->Integrator == IMPLICIT;
+  double maxStep = this->TimeStep > 0.0 ? this->TimeStep : 0.0;
+  if (implicit && !(maxStep > 0.0))
+  {
+    maxStep = 20.0 * impl.Solid.StableTimeStep();
+  }
+  const long total = step - found;
+  for (long s = found + 1; s <= step; ++s)
+  {
+    bool aborted = false;
+    auto abort = [this, &aborted]() { return aborted = (this->GetAbortExecute() != 0); };
+    const meshfree::ElasticState previous = impl.Solid.State();
+    if (!impl.Unstable)
+    {
+      impl.Solid.Advance(times[s] - times[s - 1], maxStep, implicit, abort);
+    }
+    if (aborted)
+    {
+      impl.Solid.State() = previous;
+      output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), times[s - 1]);
+      break;
+    }
+    if (impl.Unstable || !Finite(impl.Solid.State().Position) || !Finite(impl.Solid.State().Velocity))
+    {
+      if (!impl.Unstable)
+      {
+        vtkErrorMacro("The simulation became unstable between t = " << times[s - 1] << " and " << times[s]
+                                                                    << " s; later times repeat the last finite "
+                                                                       "state. Reduce TimeStep or stiffness.");
+      }
+      impl.Unstable = true;
+      impl.Solid.State() = previous;
+    }
+    impl.Solid.State().Time = times[s];
+    impl.Cache.Insert(s, impl.Solid.State());
+    ++this->SimulatedSteps;
+    this->UpdateProgress(static_cast<double>(s - found) / static_cast<double>(std::max(1L, total)));
+  }
+  this->ConjugateGradientIterations = static_cast<int>(impl.Solid.CGIterations());
+
+  // Phyxels block: positions and the fields of this state (strain and stress computed here only).
+  const meshfree::ElasticSolid& solid = impl.Solid;
+  const meshfree::ElasticState& state = solid.State();
+  const vtkIdType n = static_cast<vtkIdType>(solid.Size());
+  std::vector<double> F, strain, stress, det;
+  solid.ComputeDeformation(F, strain, stress, det);
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  std::copy(state.Position.begin(), state.Position.end(), static_cast<double*>(points->GetVoidPointer(0)));
+  phyxels->SetPoints(points);
+  vtkNew<vtkCellArray> verts;
+  vtkNew<vtkIdTypeArray> offsets, connectivity;
+  offsets->SetNumberOfTuples(n + 1);
+  connectivity->SetNumberOfTuples(n);
+  std::vector<double> displacement(3 * n), vonMises(n);
+  vtkNew<vtkIdTypeArray> id;
+  id->SetName("Id");
+  id->SetNumberOfTuples(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    offsets->SetValue(i, i);
+    connectivity->SetValue(i, i);
+    id->SetValue(i, i);
+    for (int a = 0; a < 3; ++a)
+    {
+      displacement[3 * i + a] = state.Position[3 * i + a] - solid.RestPositions()[3 * i + a];
+    }
+    vonMises[i] = meshfree::VonMisesStress(&stress[6 * i]);
+  }
+  offsets->SetValue(n, n);
+  verts->SetData(offsets, connectivity);
+  phyxels->SetVerts(verts);
+  vtkPointData* pd = phyxels->GetPointData();
+  pd->AddArray(MakeArray("Displacement", 3, n, displacement.data()));
+  pd->AddArray(MakeArray("Velocity", 3, n, state.Velocity.data()));
+  pd->AddArray(MakeArray("Strain", 6, n, strain.data()));
+  pd->AddArray(MakeArray("Stress", 6, n, stress.data()));
+  pd->AddArray(MakeArray("VonMises", 1, n, vonMises.data()));
+  pd->AddArray(MakeArray("DetJ", 1, n, det.data()));
+  pd->AddArray(MakeArray("Mass", 1, n, solid.Masses().data()));
+  pd->AddArray(MakeArray("Volume", 1, n, solid.Volumes().data()));
+  pd->AddArray(id);
+  pd->SetActiveScalars("VonMises");
+
+  // Surface block: every vertex follows the MLS displacement field of nearby phyxels [4.43-4.44].
+  if (!impl.SurfacePoints.empty())
+  {
+    std::vector<double> deformed, surfaceDisplacement, normals;
+    impl.Surface.Deform(solid, F, deformed, surfaceDisplacement);
+    meshfree::VertexNormals(deformed, impl.Triangles, normals);
+    const vtkIdType nv = static_cast<vtkIdType>(deformed.size() / 3);
+    vtkNew<vtkPolyData> surface;
+    vtkNew<vtkPoints> sp;
+    sp->SetDataTypeToDouble();
+    sp->SetNumberOfPoints(nv);
+    std::copy(deformed.begin(), deformed.end(), static_cast<double*>(sp->GetVoidPointer(0)));
+    surface->SetPoints(sp);
+    vtkNew<vtkCellArray> tris;
+    const vtkIdType nt = static_cast<vtkIdType>(impl.Triangles.size() / 3);
+    vtkNew<vtkIdTypeArray> toff, tconn;
+    toff->SetNumberOfTuples(nt + 1);
+    tconn->SetNumberOfTuples(3 * nt);
+    for (vtkIdType t = 0; t <= nt; ++t)
+    {
+      toff->SetValue(t, 3 * t);
+    }
+    for (vtkIdType c = 0; c < 3 * nt; ++c)
+    {
+      tconn->SetValue(c, impl.Triangles[c]);
+    }
+    tris->SetData(toff, tconn);
+    surface->SetPolys(tris);
+    surface->GetPointData()->AddArray(MakeArray("Displacement", 3, nv, surfaceDisplacement.data()));
+    auto normalArray = MakeArray("Normals", 3, nv, normals.data());
+    surface->GetPointData()->SetNormals(normalArray);
+    output->SetBlock(1, surface);
+    output->GetMetaData(1u)->Set(vtkCompositeDataSet::NAME(), "Surface");
+  }
+  return 1;
+}
+
+void vtkMeshFreeDeformableSolid::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Shape: " << this->Shape << "\n";
+  os << indent << "ShapeBounds: " << this->ShapeBounds[0] << " " << this->ShapeBounds[1] << " "
+     << this->ShapeBounds[2] << " " << this->ShapeBounds[3] << " " << this->ShapeBounds[4] << " "
+     << this->ShapeBounds[5] << "\n";
+  os << indent << "PhyxelSpacing: " << this->PhyxelSpacing << "\n";
+  os << indent << "SurfaceResolution: " << this->SurfaceResolution << "\n";
+  os << indent << "YoungModulus: " << this->YoungModulus << "\n";
+  os << indent << "PoissonRatio: " << this->PoissonRatio << "\n";
+  os << indent << "Density: " << this->Density << "\n";
+  os << indent << "VolumeStiffness: " << this->VolumeStiffness << "\n";
+  os << indent << "NeighborCount: " << this->NeighborCount << "\n";
+  os << indent << "SupportScale: " << this->SupportScale << "\n";
+  os << indent << "WeightFunction: " << this->WeightFunction << "\n";
+  os << indent << "GradientBasis: " << this->GradientBasis << "\n";
+  os << indent << "HourglassStiffness: " << this->HourglassStiffness << "\n";
+  os << indent << "PlasticYield: " << this->PlasticYield << "\n";
+  os << indent << "PlasticCreep: " << this->PlasticCreep << "\n";
+  os << indent << "PlasticMaxStrain: " << this->PlasticMaxStrain << "\n";
+  os << indent << "Integrator: " << this->Integrator << "\n";
+  os << indent << "TimeStep: " << this->TimeStep << "\n";
+  os << indent << "Damping: " << this->Damping << "\n";
+  os << indent << "Gravity: " << this->Gravity[0] << " " << this->Gravity[1] << " " << this->Gravity[2] << "\n";
+  os << indent << "InitialVelocity: " << this->InitialVelocity[0] << " " << this->InitialVelocity[1] << " "
+     << this->InitialVelocity[2] << "\n";
+  os << indent << "Container: " << this->Container << "\n";
+  os << indent << "Restitution: " << this->Restitution << "\n";
+  os << indent << "Friction: " << this->Friction << "\n";
+  os << indent << "SelfContact: " << this->SelfContact << "\n";
+  os << indent << "EndTime: " << this->EndTime << "\n";
+  os << indent << "OutputInterval: " << this->OutputInterval << "\n";
+  os << indent << "CacheSize: " << this->CacheSize << "\n";
+  os << indent << "NumberOfPhyxels: " << this->NumberOfPhyxels << "\n";
+  os << indent << "StableTimeStep: " << this->StableTimeStep << "\n";
+}
