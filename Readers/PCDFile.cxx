@@ -1,0 +1,185 @@
+// .pcd files in memory: buffers VTK arrays can adopt, the whole-file map/read, and dropping invalid points.
+#include "PCDFormat.h"
+#include "PCDInternal.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace meshfree
+{
+namespace pcd
+{
+
+bool Buffer::Allocate(std::size_t bytes)
+{
+  this->Ptr.reset(static_cast<unsigned char*>(std::malloc(bytes > 0 ? bytes : 1)));
+  this->Size = this->Ptr ? bytes : 0;
+#ifdef MADV_POPULATE_WRITE
+  // A large fresh block would otherwise take one page fault per 4 KB on first touch, which in a virtual
+  // machine is the main cost of a cold read of a binary file; the kernel prefaults it in one call instead.
+  // (Advice only: on an older kernel it fails and the pages fault in as usual.)
+  constexpr std::size_t Page = 4096, Large = std::size_t(1) << 20;
+  if (this->Ptr && bytes >= Large)
+  {
+    const auto begin = (reinterpret_cast<std::uintptr_t>(this->Ptr.get()) + Page - 1) & ~(Page - 1);
+    const auto end = (reinterpret_cast<std::uintptr_t>(this->Ptr.get()) + bytes) & ~(Page - 1);
+    if (end > begin)
+      madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+  }
+#endif
+  return this->Ptr != nullptr;
+}
+
+unsigned char* Buffer::Release()
+{
+  this->Size = 0;
+  return this->Ptr.release();
+}
+
+bool LoadFile(const std::string& path, Buffer& bytes, std::string& error)
+{
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f)
+  {
+    error = "cannot open '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  bool ok = std::fseek(f, 0, SEEK_END) == 0;
+  long length = ok ? std::ftell(f) : -1;
+  ok = ok && length >= 0 && std::fseek(f, 0, SEEK_SET) == 0;
+  if (ok && !bytes.Allocate(static_cast<std::size_t>(length)))
+  {
+    std::fclose(f);
+    error = "out of memory reading '" + path + "'";
+    return false;
+  }
+  ok = ok && std::fread(bytes.Data(), 1, bytes.Bytes(), f) == bytes.Bytes();
+  std::fclose(f);
+  if (!ok)
+    error = "cannot read '" + path + "'";
+  return ok;
+}
+
+MappedFile::~MappedFile()
+{
+  if (this->Mapped)
+    munmap(const_cast<char*>(this->Ptr), this->Length);
+}
+
+bool MappedFile::Open(const std::string& path, std::string& error)
+{
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0)
+  {
+    error = "cannot open '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  struct stat st;
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+  {
+    ::close(fd);
+    error = "'" + path + "' is not a regular file";
+    return false;
+  }
+  this->Length = static_cast<std::size_t>(st.st_size);
+  if (this->Length > 0)
+  {
+    void* p = mmap(nullptr, this->Length, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    if (p == MAP_FAILED)
+    {
+      ::close(fd);
+      this->Length = 0;
+      error = "cannot map '" + path + "': " + std::strerror(errno);
+      return false;
+    }
+    this->Ptr = static_cast<const char*>(p);
+    this->Mapped = true;
+#ifdef MADV_POPULATE_READ
+    madvise(p, this->Length, MADV_POPULATE_READ); // page tables in one call, not one fault per page
+#endif
+  }
+  ::close(fd);
+  return true;
+}
+
+std::uint64_t DropInvalidPoints(Cloud& cloud, std::vector<std::uint64_t>* keptIndex)
+{
+  const std::uint64_t n = cloud.Head.Points;
+  // The coordinates: (data, size in bytes, stride in bytes) of x, y, z where they are floating point.
+  struct Coordinate
+  {
+    const unsigned char* Data;
+    int Size;
+    std::size_t Stride;
+  };
+  std::vector<Coordinate> coords;
+  if (cloud.PointsSize)
+    for (int k = 0; k < 3; ++k)
+      coords.push_back({ cloud.Points.Data() + k * cloud.PointsSize, cloud.PointsSize,
+        3 * static_cast<std::size_t>(cloud.PointsSize) });
+  for (std::size_t c = 0; c < cloud.Columns.size(); ++c)
+  {
+    const Field& f = cloud.Head.Fields[cloud.ColumnField[c]];
+    if ((f.Name == "x" || f.Name == "y" || f.Name == "z") && f.Type == 'F' && f.Count == 1)
+      coords.push_back({ cloud.Columns[c].Data(), f.Size, static_cast<std::size_t>(f.Size) });
+  }
+  auto valid = [&](std::uint64_t i) {
+    for (const Coordinate& c : coords)
+    {
+      double v;
+      if (c.Size == 4)
+      {
+        float x;
+        std::memcpy(&x, c.Data + c.Stride * i, 4);
+        v = x;
+      }
+      else
+        std::memcpy(&v, c.Data + c.Stride * i, 8);
+      if (!std::isfinite(v))
+        return false;
+    }
+    return true;
+  };
+  std::vector<std::uint64_t> kept;
+  std::uint64_t firstBad = n;
+  for (std::uint64_t i = 0; i < n && firstBad == n; ++i)
+    if (!valid(i))
+      firstBad = i;
+  if (firstBad < n)
+  {
+    kept.reserve(n);
+    for (std::uint64_t i = 0; i < n; ++i)
+      if (i < firstBad || (i > firstBad && valid(i)))
+        kept.push_back(i);
+    auto compact = [&](Buffer& buffer, std::size_t b) {
+      unsigned char* d = buffer.Data();
+      for (std::size_t k = firstBad; k < kept.size(); ++k)
+        std::memmove(d + k * b, d + kept[k] * b, b);
+      buffer.Shrink(kept.size() * b);
+    };
+    for (std::size_t c = 0; c < cloud.Columns.size(); ++c)
+      compact(cloud.Columns[c], cloud.Head.Fields[cloud.ColumnField[c]].Bytes());
+    if (cloud.PointsSize)
+      compact(cloud.Points, 3 * static_cast<std::size_t>(cloud.PointsSize));
+    cloud.Head.Points = kept.size();
+  }
+  const std::uint64_t dropped = firstBad < n ? n - kept.size() : 0;
+  if (keptIndex)
+  {
+    if (firstBad == n)
+      kept.clear();
+    keptIndex->swap(kept);
+  }
+  return dropped;
+}
+
+} // namespace pcd
+} // namespace meshfree

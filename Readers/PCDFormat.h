@@ -1,0 +1,140 @@
+// The Point Cloud Library's .pcd format, version 0.7, without VTK: header, the three encodings
+// (ascii, binary, binary_compressed with LZF) in both directions. The VTK readers and writers in this
+// folder are thin layers over it; the fuzz harness and the unit tests link it alone.
+//
+// Format facts (PCL's "The PCD (Point Cloud Data) file format", v0.7):
+// - The header lists FIELDS, then per field SIZE (bytes), TYPE (I/U/F) and COUNT (values), then WIDTH,
+//   HEIGHT (1 for an unorganised cloud), VIEWPOINT (tx ty tz qw qx qy qz), POINTS (= WIDTH*HEIGHT) and
+//   DATA ascii|binary|binary_compressed; the data starts right after the DATA line.
+// - binary: POINTS records of the fields in order (array of structures).
+// - binary_compressed: uint32 compressed size, uint32 uncompressed size, then LZF bytes that expand to
+//   one block per field (structure of arrays). PCL leaves the padding fields ("_") out of these blocks.
+// - ascii: one point per line; PCL leaves the padding fields out, and writes the packed "rgb" float as
+//   the uint32 of its bits (older versions wrote the float itself): both are accepted.
+#ifndef meshfree_PCDFormat_h
+#define meshfree_PCDFormat_h
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace meshfree
+{
+namespace pcd
+{
+
+enum class Encoding
+{
+  Ascii,
+  Binary,
+  BinaryCompressed
+};
+const char* EncodingName(Encoding encoding);
+
+struct Field
+{
+  std::string Name;
+  int Size = 4;     // bytes per value: 1, 2, 4 or 8
+  char Type = 'F';  // 'I' signed, 'U' unsigned, 'F' floating point (4 or 8 bytes)
+  int Count = 1;    // values per point
+  bool IsPadding() const { return this->Name == "_"; }
+  std::size_t Bytes() const { return static_cast<std::size_t>(this->Size) * this->Count; }
+};
+
+struct Header
+{
+  std::vector<Field> Fields;
+  std::uint64_t Width = 0;
+  std::uint64_t Height = 1;
+  std::uint64_t Points = 0;
+  double Viewpoint[7] = { 0, 0, 0, 1, 0, 0, 0 };
+  Encoding Data = Encoding::Ascii;
+  std::size_t DataStart = 0; // byte offset of the data section in the file
+
+  std::size_t PointBytes(bool withPadding) const;
+  int FieldIndex(const std::string& name) const; // -1 when absent
+};
+
+/// A malloc'ed block, so that a VTK array can adopt it without a copy (VTK_DATA_ARRAY_FREE).
+class Buffer
+{
+public:
+  bool Allocate(std::size_t bytes); // false when out of memory
+  unsigned char* Data() const { return this->Ptr.get(); }
+  std::size_t Bytes() const { return this->Size; }
+  unsigned char* Release(); // the caller must free() it
+  void Shrink(std::size_t bytes) { this->Size = bytes; }
+
+private:
+  struct Free
+  {
+    void operator()(unsigned char* p) const { std::free(p); }
+  };
+  std::unique_ptr<unsigned char, Free> Ptr;
+  std::size_t Size = 0;
+};
+
+/// A decoded cloud: one column per non-padding field (Points x Count values of the field's own type,
+/// interleaved), in the order of Header::Fields. When decoded with interleaveXYZ and the fields x, y, z are
+/// one floating type with COUNT 1, they go straight into Points as x y z triples (PointsSize 4: float,
+/// 8: double), the layout of vtkPoints, and have no column.
+struct Cloud
+{
+  Header Head;
+  std::vector<int> ColumnField; // index into Head.Fields of each column
+  std::vector<Buffer> Columns;
+  Buffer Points;
+  int PointsSize = 0; // 0: no interleaved points
+};
+
+/// Parses the header at the start of data. On failure returns false and a message naming the problem.
+bool ParseHeader(const char* data, std::size_t size, Header& header, std::string& error);
+
+/// Decodes a whole file held in memory. On failure the cloud is left empty and error says why.
+bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error, bool interleaveXYZ = false);
+
+/// Reads and decodes a file (one bulk read).
+bool ReadFile(const std::string& path, Cloud& cloud, std::string& error, bool interleaveXYZ = false);
+
+/// Removes the points whose x, y or z is NaN or infinite (PCL's marker of invalid points), from every
+/// column (and from Points). keptIndex (optional) receives the original index of each kept point, or
+/// nothing when no point was dropped. Returns how many went.
+std::uint64_t DropInvalidPoints(Cloud& cloud, std::vector<std::uint64_t>* keptIndex = nullptr);
+
+/// Encodes a cloud: header.Fields (no padding), Width/Height/Points, Viewpoint, Data are used;
+/// columns[i] holds Points x Count values of field i, interleaved. The result is appended to out.
+bool Encode(const Header& header, const std::vector<const void*>& columns, std::string& out,
+  std::string& error);
+
+/// Encode + write to path.
+bool WriteFile(const std::string& path, const Header& header,
+  const std::vector<const void*>& columns, std::string& error);
+
+/// A read-only memory map of a whole file (pre-faulted: the kernel maps the page cache in one call, no copy).
+class MappedFile
+{
+public:
+  MappedFile() = default;
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  ~MappedFile();
+  bool Open(const std::string& path, std::string& error);
+  const char* Data() const { return this->Ptr; }
+  std::size_t Size() const { return this->Length; }
+
+private:
+  const char* Ptr = "";
+  std::size_t Length = 0;
+  bool Mapped = false;
+};
+
+/// Whole file into memory with one read; false with a message on failure.
+bool LoadFile(const std::string& path, Buffer& bytes, std::string& error);
+
+} // namespace pcd
+} // namespace meshfree
+
+#endif

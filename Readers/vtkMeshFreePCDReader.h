@@ -1,0 +1,64 @@
+/**
+ * @class   vtkMeshFreePCDReader
+ * @brief   reads the Point Cloud Library's .pcd files (v0.7: ascii, binary, binary_compressed)
+ *
+ * Output: a vtkPolyData with one vertex cell per point.
+ * - The fields `x`, `y`, `z` are the points (float when all three are 4-byte floats, else double; a missing
+ *   one is 0).
+ * - Every other field is a point array named as in the file, of the field's own type (SIZE 1/2/4/8, TYPE
+ *   I/U/F), with COUNT components. PCL's packed colour fields `rgb` (float) and `rgba` (uint32) become
+ *   unsigned-char arrays `rgb` (3 components) and `rgba` (4). Padding fields (`_`) are skipped.
+ * - Field data: `Viewpoint` (tx ty tz qw qx qy qz) and `OrganizedDimensions` (WIDTH, HEIGHT).
+ * - Points with a NaN (or infinite) x, y or z, PCL's marker of invalid points, are dropped with a warning
+ *   giving their count, unless KeepInvalidPoints is on. When points of an organised cloud (HEIGHT > 1) are
+ *   dropped, the point array `PixelIndex` keeps each point's row-major index in the WIDTH x HEIGHT grid.
+ *
+ * A file that does not parse (truncated data, counts that do not match, unknown types, compressed sizes
+ * that lie, ...) gives an error naming the problem and an empty output.
+ *
+ * @sa vtkMeshFreePCDWriter vtkMeshFreeXYZReader
+ */
+#ifndef vtkMeshFreePCDReader_h
+#define vtkMeshFreePCDReader_h
+
+#include "MeshFreeReadersModule.h"
+#include "vtkPolyDataAlgorithm.h"
+
+class MESHFREEREADERS_EXPORT vtkMeshFreePCDReader : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkMeshFreePCDReader* New();
+  vtkTypeMacro(vtkMeshFreePCDReader, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /** The .pcd file to read. */
+  vtkSetStringMacro(FileName);
+  vtkGetStringMacro(FileName);
+  ///@}
+
+  ///@{
+  /** Keep the points whose coordinates are NaN (PCL's invalid points) instead of dropping them. Default off. */
+  vtkSetMacro(KeepInvalidPoints, bool);
+  vtkGetMacro(KeepInvalidPoints, bool);
+  vtkBooleanMacro(KeepInvalidPoints, bool);
+  ///@}
+
+  /** 1 when the file starts with a valid .pcd header, 0 otherwise (reads the first 64 KB only). */
+  int CanReadFile(const char* filename);
+
+protected:
+  vtkMeshFreePCDReader();
+  ~vtkMeshFreePCDReader() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  char* FileName = nullptr;
+  bool KeepInvalidPoints = false;
+
+private:
+  vtkMeshFreePCDReader(const vtkMeshFreePCDReader&) = delete;
+  void operator=(const vtkMeshFreePCDReader&) = delete;
+};
+
+#endif

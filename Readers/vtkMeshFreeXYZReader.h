@@ -1,0 +1,62 @@
+/**
+ * @class   vtkMeshFreeXYZReader
+ * @brief   reads text point clouds (.xyz, .pts): x y z and value columns, one point per line
+ *
+ * Columns are separated by white space, commas or semicolons. Optional lines before the data: Leica's
+ * point count (.pts), a header naming the columns (`x y z intensity`, CloudCompare's `//X Y Z R G B`),
+ * comments (`#`, `//`). The columns named x, y, z (else the first three) are the points (double); every
+ * other column is a double point array named by the header, or `Column<k>` (k counts from 1). Columns
+ * named r, g, b (or red, green, blue) holding integers 0-255 become one unsigned-char array `RGB`.
+ * Without a header, a .pts file follows Leica's layout: x y z [intensity] [r g b].
+ * Output: a vtkPolyData with one vertex cell per point. Rows with a NaN coordinate are dropped with a
+ * warning unless KeepInvalidPoints is on. A malformed file gives an error naming the line and an empty output.
+ *
+ * CanReadFile accepts only text whose first lines are consistent rows of numbers, so that ParaView's
+ * reader factory gives real PLOT3D grids (also ".xyz") and XMol molecules to their own readers.
+ *
+ * @sa vtkMeshFreePCDReader
+ */
+#ifndef vtkMeshFreeXYZReader_h
+#define vtkMeshFreeXYZReader_h
+
+#include "MeshFreeReadersModule.h"
+#include "vtkPolyDataAlgorithm.h"
+
+class MESHFREEREADERS_EXPORT vtkMeshFreeXYZReader : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkMeshFreeXYZReader* New();
+  vtkTypeMacro(vtkMeshFreeXYZReader, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /** The .xyz / .pts file to read. */
+  vtkSetStringMacro(FileName);
+  vtkGetStringMacro(FileName);
+  ///@}
+
+  ///@{
+  /** Keep the rows whose coordinates are NaN instead of dropping them. Default off. */
+  vtkSetMacro(KeepInvalidPoints, bool);
+  vtkGetMacro(KeepInvalidPoints, bool);
+  vtkBooleanMacro(KeepInvalidPoints, bool);
+  ///@}
+
+  /** 1 when the first 64 KB of the file read as a text point cloud, 0 otherwise. */
+  int CanReadFile(const char* filename);
+
+protected:
+  vtkMeshFreeXYZReader();
+  ~vtkMeshFreeXYZReader() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  char* FileName = nullptr;
+  bool KeepInvalidPoints = false;
+
+private:
+  vtkMeshFreeXYZReader(const vtkMeshFreeXYZReader&) = delete;
+  void operator=(const vtkMeshFreeXYZReader&) = delete;
+};
+
+#endif
