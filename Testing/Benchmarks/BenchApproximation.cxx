@@ -1,6 +1,7 @@
 // Benchmark (not a test) of the VTK-free MLS core: evaluations per second of MLS degree 2 with 20
 // neighbours in 2D (Halton cloud of N = 10,000 points, probes on a grid), single thread and all threads.
 // Usage: BenchApproximation [evaluations (default 1,000,000)]
+#include "TestFunctions.h"
 #include "Approximation.h"
 
 #include <chrono>
@@ -15,16 +16,7 @@
 
 namespace
 {
-double Halton(int i, int base)
-{
-  double f = 1.0, r = 0.0;
-  for (; i > 0; i /= base)
-  {
-    f /= base;
-    r += f * (i % base);
-  }
-  return r;
-}
+using meshfree::testing::Halton;
 }
 
 int main(int argc, char* argv[])

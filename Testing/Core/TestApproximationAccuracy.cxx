@@ -3,6 +3,7 @@
 // on Halton points in [0,1]^2, evaluated on the 101 x 101 grid: MLS degree 2 rms <= 5e-4 at N = 1,000 and
 // <= 2e-5 at N = 10,000; observed convergence order ~ m + 1 for degree m = 0..3 over N = 250 ... 16,000;
 // Renka-Brown's other test functions converge too; the thesis' 9-point example (§3.4).
+#include "TestFunctions.h"
 #include "Approximation.h"
 
 #include <gtest/gtest.h>
@@ -14,27 +15,10 @@
 
 namespace
 {
+using meshfree::testing::Franke;
+using meshfree::testing::Halton;
 using namespace meshfree;
 using Function = std::function<double(double, double)>;
-
-double Halton(int i, int base)
-{
-  double f = 1.0, r = 0.0;
-  for (; i > 0; i /= base)
-  {
-    f /= base;
-    r += f * (i % base);
-  }
-  return r;
-}
-
-double Franke(double x, double y)
-{
-  return 0.75 * std::exp(-((9 * x - 2) * (9 * x - 2) + (9 * y - 2) * (9 * y - 2)) / 4) +
-    0.75 * std::exp(-(9 * x + 1) * (9 * x + 1) / 49 - (9 * y + 1) / 10) +
-    0.5 * std::exp(-((9 * x - 7) * (9 * x - 7) + (9 * y - 3) * (9 * y - 3)) / 4) -
-    0.2 * std::exp(-(9 * x - 4) * (9 * x - 4) - (9 * y - 7) * (9 * y - 7));
-}
 
 struct Errors
 {

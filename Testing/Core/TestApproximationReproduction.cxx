@@ -3,6 +3,7 @@
 // polynomials of degree <= m to 1e-9 relative, for clouds at the origin, offset by 1e6, and scaled by 1e-6
 // and 1e6, in 2D (flat in z), in 3D and on a tilted plane; gradients of the fits reproduce the
 // polynomials' gradients.
+#include "TestFunctions.h"
 #include "Approximation.h"
 
 #include <gtest/gtest.h>
@@ -14,18 +15,8 @@
 
 namespace
 {
+using meshfree::testing::Halton;
 using namespace meshfree;
-
-double Halton(int i, int base)
-{
-  double f = 1.0, r = 0.0;
-  for (; i > 0; i /= base)
-  {
-    f /= base;
-    r += f * (i % base);
-  }
-  return r;
-}
 
 // A random polynomial of total degree m in the unit coordinates u = (x - offset) / scale (3 variables).
 struct Polynomial

@@ -1,6 +1,7 @@
 // vtkMeshFreeMLSKernel inside VTK's own vtkPointInterpolator: linear data reproduced exactly (VTK's
 // kernels cannot), Franke's F1 as accurate as the Meshless Approximation filter's MLS (same shape functions,
 // same neighbours), and far better than vtkGaussianKernel.
+#include "TestFunctions.h"
 #include "vtkMeshFreeMLSKernel.h"
 #include "vtkMeshlessApproximation.h"
 
@@ -20,25 +21,8 @@
 
 namespace
 {
-double Halton(int i, int base)
-{
-  double f = 1.0, r = 0.0;
-  for (; i > 0; i /= base)
-  {
-    f /= base;
-    r += f * (i % base);
-  }
-  return r;
-}
-
-double Franke(double x, double y)
-{
-  return 0.75 * std::exp(-((9 * x - 2) * (9 * x - 2) + (9 * y - 2) * (9 * y - 2)) / 4) +
-    0.75 * std::exp(-(9 * x + 1) * (9 * x + 1) / 49 - (9 * y + 1) / 10) +
-    0.5 * std::exp(-((9 * x - 7) * (9 * x - 7) + (9 * y - 3) * (9 * y - 3)) / 4) -
-    0.2 * std::exp(-(9 * x - 4) * (9 * x - 4) - (9 * y - 7) * (9 * y - 7));
-}
-
+using meshfree::testing::Franke;
+using meshfree::testing::Halton;
 double Rms(vtkDataSet* out, const char* name, double (*exact)(double, double), double& maxError)
 {
   vtkDataArray* a = out->GetPointData()->GetArray(name);

@@ -1,6 +1,7 @@
 // vtkMeshlessApproximation as a VTK filter: default grid (101 x 101 x 1 for a flat cloud), integer and
 // multi-component arrays, NaN coordinates, an empty cloud, SPH volumes from Mass/Density, HeightField,
 // a probe, and no NaN anywhere in the output.
+#include "TestFunctions.h"
 #include "vtkMeshlessApproximation.h"
 
 #include "vtkDataArray.h"
@@ -19,17 +20,7 @@
 
 namespace
 {
-double Halton(int i, int base)
-{
-  double f = 1.0, r = 0.0;
-  for (; i > 0; i /= base)
-  {
-    f /= base;
-    r += f * (i % base);
-  }
-  return r;
-}
-
+using meshfree::testing::Halton;
 #define CHECK(cond)                                                                                   \
   if (!(cond))                                                                                          \
   {                                                                                                     \
