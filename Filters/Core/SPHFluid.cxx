@@ -196,6 +196,11 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   const double mu = p.Viscosity, sigma = p.SurfaceTension;
   const bool viscous = mu > 0.0, tension = sigma > 0.0;
   const int d = p.Dimension;
+  // Monaghan's artificial viscosity: Pi_ij = -alpha c0 hs (v_ij . r_ij) / (rho_bar (r^2 + 0.01 hs^2)) for
+  // approaching pairs, hs = h / 2 the smoothing length of the support radius h.
+  const double hs = 0.5 * h;
+  const double avFactor = p.ArtificialViscosity * this->C0 * hs, avEps = 0.01 * hs * hs;
+  const bool artificial = avFactor > 0.0;
 #pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
   for (Index i = 0; i < n; ++i)
   {
@@ -220,8 +225,14 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
       if (dist > 0.0)
       {
         // -m (p_i/rho_i^2 + p_j/rho_j^2) grad W, grad W = -gradientNorm shape(r) r
-        const double coefficient =
-          m * (termI + pressure[j] / (rhoJ * rhoJ)) * gradientNorm * this->GradientShape(r2, dist);
+        double pair = termI + pressure[j] / (rhoJ * rhoJ);
+        if (artificial)
+        {
+          const double* vj = v + 3 * j;
+          const double vr = (vi[0] - vj[0]) * r[0] + (vi[1] - vj[1]) * r[1] + (vi[2] - vj[2]) * r[2];
+          pair += vr < 0.0 ? -avFactor * vr / (0.5 * (rhoI + rhoJ) * (r2 + avEps)) : 0.0;
+        }
+        const double coefficient = m * pair * gradientNorm * this->GradientShape(r2, dist);
         ap[0] += coefficient * r[0];
         ap[1] += coefficient * r[1];
         ap[2] += coefficient * r[2];
@@ -260,8 +271,10 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
       {
         // Symmetric pair force with the dummy's extrapolated pressure; its density from the EOS.
         const double rhoB = this->DensityOf(pb[b]);
-        const double coefficient =
-          m * (termI + pb[b] / (rhoB * rhoB)) * gradientNorm * this->GradientShape(r2, dist);
+        // No artificial viscosity against the wall: with a particle sliding along it, the dummies ahead are
+        // approached and those behind are not, so the term would act as wall friction (free slip wanted).
+        const double pair = termI + pb[b] / (rhoB * rhoB);
+        const double coefficient = m * pair * gradientNorm * this->GradientShape(r2, dist);
         ap[0] += coefficient * r[0];
         ap[1] += coefficient * r[1];
         ap[2] += coefficient * r[2];

@@ -11,6 +11,19 @@
 //  * viscosity  [5.46]: a_i = (mu / rho_i) sum_j m (v_j - v_i) / rho_j lap W_visc(r_ij), lap W_visc = L (h - r)
 //               (5.49; in 2D L = 40/(pi h^5), the constant that makes the estimate exact for quadratic fields,
 //               as 45/(pi h^6) does in 3D)
+//  * artificial viscosity (Monaghan 1992), ArtificialViscosity = alpha (default 0.02, DualSPHysics' value for
+//               its dam break; peers use 0.01-0.1):
+//               Pi_ij = -alpha c0 hs (v_ij . r_ij) / (rho_bar (r^2 + 0.01 hs^2)) for approaching fluid pairs
+//               (v_ij . r_ij < 0), else 0, hs = h / 2, added to the pressure term p_i/rho_i^2 + p_j/rho_j^2.
+//               It damps the acoustic noise of the weakly compressible fluid; on the dam-break front its effect
+//               is small (TestSPHDamBreak, T = 2.3-3.3: the front leads Martin & Moyce by 7.3-10.5 % with
+//               alpha = 0, 7.5-10.5 % with 0.02, 7-10 % with 0.05). Antisymmetric, so momentum is kept. Not
+//               applied against wall dummies: a particle sliding along a wall approaches the dummies ahead of
+//               it and leaves those behind, so the term would act as wall friction (measured: it slowed the
+//               dam-break front by 4-5 % of Z, which is not free slip). Its diffusion number is far below the
+//               acoustic limit for alpha <= 1 (nu_AV ~ alpha c0 h / 16), so the CFL step needs no extra term.
+//               Density diffusion (delta-SPH) is not offered: it is a term of the continuity equation, and the
+//               density here is the kernel sum [5.32].
 //  * surface tension from the poly6 colour field c = sum m/rho W: a_i = -sigma lap(c) n/|n| / rho_i where
 //    |n| = |grad c| > 0.25 / h (Mueller 2003, 5.3.4); walls count as fluid in c (neutral wetting)
 //  * gravity.
@@ -93,6 +106,7 @@ struct SPHParameters
   SPHKernelPair Kernels = SPHKernelPair::Spiky;
   double Viscosity = 0.0;            ///< dynamic viscosity mu, Pa s
   double SurfaceTension = 0.0;       ///< sigma, N/m
+  double ArtificialViscosity = 0.02; ///< Monaghan's alpha (0: off); see the header comment
   double Gravity[3] = { 0.0, 0.0, -9.81 };
   double TimeStep = 1e-3;            ///< largest step, s
   double CFLNumber = 0.25;           ///< lambda; 0: fixed step

@@ -97,6 +97,14 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
   {
     fail("Viscosity and SurfaceTension must be >= 0");
   }
+  if (!(p.ArtificialViscosity >= 0.0) || !std::isfinite(p.ArtificialViscosity))
+  {
+    fail("ArtificialViscosity must be >= 0");
+  }
+  if (p.ArtificialViscosity > 1.0)
+  {
+    this->WarningList.push_back("ArtificialViscosity above 1 makes the fluid very viscous (0.01 to 0.1 is usual)");
+  }
   if (!(p.TimeStep > 0.0) || !std::isfinite(p.TimeStep) || !(p.CFLNumber >= 0.0) || !std::isfinite(p.CFLNumber))
   {
     fail("TimeStep must be positive and CFLNumber >= 0");

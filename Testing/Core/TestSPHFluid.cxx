@@ -164,6 +164,7 @@ TEST(SPHFluid, EnergyIsConservedWithoutViscosity)
   // energy constant up to the integrator's error).
   SPHParameters p = FreeBlock(2, SPHKernelPair::Spiky);
   p.Viscosity = 0.0;
+  p.ArtificialViscosity = 0.0;
   SPHFluid fluid;
   fluid.Setup(p);
   SPHState s = fluid.InitialState();
@@ -180,6 +181,22 @@ TEST(SPHFluid, EnergyIsConservedWithoutViscosity)
   const double e0 = energy(s);
   ASSERT_EQ(fluid.Advance(s, 0.2), SPHFluid::Status::Ok);
   EXPECT_NEAR(energy(s), e0, 0.03 * e0);
+
+  // The artificial viscosity (alpha = 0.1) only dissipates, and keeps the momentum.
+  p.ArtificialViscosity = 0.1;
+  SPHFluid damped;
+  damped.Setup(p);
+  SPHState t = damped.InitialState();
+  Randomize(t, 3u, 2);
+  const auto before = SPHFluid::Statistics(t, damped.ParticleMass());
+  const double t0 = energy(t);
+  ASSERT_EQ(damped.Advance(t, 0.2), SPHFluid::Status::Ok);
+  const auto after = SPHFluid::Statistics(t, damped.ParticleMass());
+  EXPECT_LT(energy(t), 0.9 * t0);
+  for (int a = 0; a < 3; ++a)
+  {
+    EXPECT_NEAR(after.Momentum[a], before.Momentum[a], 1e-10 * damped.ParticleMass() * t.Size());
+  }
 }
 
 TEST(SPHFluid, MuellerKernelsAreNotConservative)
@@ -188,6 +205,7 @@ TEST(SPHFluid, MuellerKernelsAreNotConservative)
   // gains energy (the pressure force is not the gradient of the internal energy).
   SPHParameters p = FreeBlock(2, SPHKernelPair::Mueller);
   p.Viscosity = 0.0;
+  p.ArtificialViscosity = 0.0;
   SPHFluid fluid;
   fluid.Setup(p);
   SPHState s = fluid.InitialState();
@@ -242,6 +260,11 @@ TEST(SPHFluid, HostileSettings)
     SPHFluid fluid;
     EXPECT_THROW(fluid.Setup(q), std::invalid_argument);
     q.ParticleSpacing = std::nan("");
+    EXPECT_THROW(fluid.Setup(q), std::invalid_argument);
+    q.ParticleSpacing = 0.01;
+    q.ArtificialViscosity = -0.1;
+    EXPECT_THROW(fluid.Setup(q), std::invalid_argument);
+    q.ArtificialViscosity = std::nan("");
     EXPECT_THROW(fluid.Setup(q), std::invalid_argument);
   }
   { // zero particles: an empty block
@@ -398,6 +421,7 @@ TEST(SPHFluid, FluidFlowsAroundAnObstacle)
     {
       front = std::max(front, s.Position[3 * i]);
     }
-    EXPECT_GT(front, 0.2) << "the fluid passes over the obstacle";
+    std::printf("%dD obstacle: front x = %.3f at t = 0.3\n", d, front);
+    EXPECT_GT(front, 0.2) << "the fluid passes over the obstacle, d = " << d;
   }
 }
