@@ -166,6 +166,7 @@ int vtkMeshFreeSPHFluid::RequestData(
   p.Kernels = static_cast<meshfree::SPHKernelPair>(this->KernelPair);
   p.Viscosity = this->Viscosity;
   p.SurfaceTension = this->SurfaceTension;
+  p.ArtificialViscosity = this->ArtificialViscosity;
   std::copy(this->Gravity, this->Gravity + 3, p.Gravity);
   p.TimeStep = this->TimeStep;
   p.CFLNumber = this->CFLNumber;
@@ -174,7 +175,7 @@ int vtkMeshFreeSPHFluid::RequestData(
   std::ostringstream key;
   key << std::hexfloat << p.Dimension << ' ' << p.ParticleSpacing << ' ' << p.SmoothingLength << ' '
       << p.RestDensity << ' ' << p.GasStiffness << ' ' << this->EquationOfState << ' ' << this->KernelPair << ' '
-      << p.Viscosity << ' ' << p.SurfaceTension << ' ' << p.TimeStep << ' ' << p.CFLNumber << ' '
+      << p.Viscosity << ' ' << p.ArtificialViscosity << ' ' << p.SurfaceTension << ' ' << p.TimeStep << ' ' << p.CFLNumber << ' '
       << this->OutputInterval << ' ' << (obstacles ? static_cast<long>(obstacles->GetMTime()) : -1L);
   for (int i = 0; i < 6; ++i)
   {
@@ -327,6 +328,7 @@ void vtkMeshFreeSPHFluid::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EquationOfState: " << this->EquationOfState << "\n";
   os << indent << "KernelPair: " << this->KernelPair << "\n";
   os << indent << "Viscosity: " << this->Viscosity << "\n";
+  os << indent << "ArtificialViscosity: " << this->ArtificialViscosity << "\n";
   os << indent << "SurfaceTension: " << this->SurfaceTension << "\n";
   os << indent << "Gravity: " << this->Gravity[0] << " " << this->Gravity[1] << " " << this->Gravity[2] << "\n";
   os << indent << "TimeStep: " << this->TimeStep << "\n";

@@ -94,6 +94,13 @@ public:
   ///@}
 
   ///@{
+  /** Monaghan's artificial viscosity α (dimensionless, acts only between approaching particles; 0: off).
+   * Default 0.02. */
+  vtkSetMacro(ArtificialViscosity, double);
+  vtkGetMacro(ArtificialViscosity, double);
+  ///@}
+
+  ///@{
   /** Surface tension σ (N/m). Default 0. */
   vtkSetMacro(SurfaceTension, double);
   vtkGetMacro(SurfaceTension, double);
@@ -170,6 +177,7 @@ protected:
   int KernelPair = 0;
   double Viscosity = 0.01;
   double SurfaceTension = 0.0;
+  double ArtificialViscosity = 0.02;
   double Gravity[3] = { 0.0, 0.0, -9.81 };
   double TimeStep = 0.002;
   double CFLNumber = 0.25;

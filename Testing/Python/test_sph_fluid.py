@@ -35,4 +35,22 @@ for t in (0.1, 0.05, 0.0):
 # The column has started to fall and spread by t = 0.1.
 out = meshfree_test.fetch(src, 0.1)
 assert np.asarray(out.Points)[:, 0].max() > 0.1
+
+
+def steps_taken():
+    src.UpdatePropertyInformation()
+    return src.GetProperty("StepsTaken").GetElement(0)
+
+
+# Every output time is cached: revisiting them takes no step; a property change invalidates the cache.
+assert abs(src.ArtificialViscosity[0] - 0.02) < 1e-12 if hasattr(src.ArtificialViscosity, "__getitem__") \
+    else abs(src.ArtificialViscosity - 0.02) < 1e-12
+before = steps_taken()
+assert before > 0, before
+for t in (0.025, 0.075, 0.1, 0.0):
+    meshfree_test.fetch(src, t)
+assert steps_taken() == before, (steps_taken(), before)
+src.ArtificialViscosity = 0.05
+meshfree_test.fetch(src, 0.025)
+assert steps_taken() > before
 print("SPH Fluid OK")
