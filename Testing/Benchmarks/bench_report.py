@@ -1,10 +1,10 @@
 """CSV schema, validation, Pareto fronts and plots of the MeshFree benchmarks (issue #7).
 
-Pure numpy + matplotlib (Agg): runs under pvpython or /usr/bin/python3. Used by run_benchmarks.py; also a
-checker of its output on its own:
+Pure numpy + matplotlib (Agg): runs under pvpython or /usr/bin/python3 (Debian's, which has matplotlib).
+Used by run_benchmarks.py; also a checker of its output on its own:
 
-    python3 Testing/Benchmarks/bench_report.py --check DIR     # well-formed CSVs with finite values
-    python3 Testing/Benchmarks/bench_report.py --plot DIR      # (re)draw the PNGs and pareto.md from the CSVs
+    /usr/bin/python3 Testing/Benchmarks/bench_report.py --check DIR     # well-formed CSVs with finite values
+    /usr/bin/python3 Testing/Benchmarks/bench_report.py --plot DIR      # (re)draw the PNGs and pareto.md from the CSVs
 """
 import csv
 import math
@@ -116,6 +116,19 @@ def label(row):
     if row["peer"] == 0 and not name.startswith("sph"):
         return "%s d%d" % (name, row["degree"])
     return name
+
+
+def family(row):
+    """Series name for the convergence/scaling plots: the method without its tuned setting (the setting may
+    change with N): 'vtk_gaussian_r2h_s2' -> 'vtk_gaussian'; ours keep the degree."""
+    import re
+    name = split_method(row["method"])[1]
+    if row["peer"] == 0:
+        return label(row)
+    tokens = name.split("_")
+    while len(tokens) > 2 and re.fullmatch(r"(r|s|p|n|k|step)[0-9.]+h?", tokens[-1]):
+        tokens.pop()
+    return "_".join(tokens)
 
 
 def groups(rows):
@@ -233,37 +246,57 @@ def plot_pareto(rows, path, field="F1", title=""):
     plt.close(fig)
 
 
+PEER_COLORS = ["#1f77b4", "#17becf", "#9467bd", "#8c564b", "#bcbd22", "#2ca02c", "#7f7f7f", "#e377c2", "#393b79",
+               "#637939", "#8c6d31", "#843c39", "#7b4173", "#3182bd"]
+
+
+def _series_style(key, row, index):
+    """Colour/marker/line of one line-plot series: ours in their family colour (solid, marker by degree),
+    peers each in its own colour (dashed)."""
+    c, m, ours = _style(row)
+    if not ours:
+        c = PEER_COLORS[index % len(PEER_COLORS)]
+    return c, m, ours
+
+
 def plot_convergence(rows, path, fields=("F1", "F1_3d"), sph=None, solid=None):
+    """rms error against N for the local methods (ours: MLS degrees 1-3, PU-WLS 2-3, SPH; every peer family),
+    plus the SPH and solid accuracy against resolution."""
     plt = _plt()
     panels = [f for f in fields if any(split_method(r["method"])[0] == f for r in rows)]
-    extra = int(bool(sph)) + int(bool(solid))
-    fig, axes = plt.subplots(1, len(panels) + extra, figsize=(4.6 * (len(panels) + extra), 4.0), squeeze=False)
-    axes = list(axes[0])
+    count = len(panels) + int(bool(sph)) + int(bool(solid))
+    cols = 2 if count > 1 else 1
+    nrows = (count + cols - 1) // cols
+    fig, axes = plt.subplots(nrows, cols, figsize=(6.0 * cols, 4.4 * nrows), squeeze=False)
+    axes = [a for row in axes for a in row]
+    for ax in axes[count:]:
+        ax.axis("off")
     for ax, field in zip(axes, panels):
         series = {}
         for r in rows:
             f, name = split_method(r["method"])
             if f != field:
                 continue
-            key = label(r)
-            # Tuned peers carry their setting in the name; one series per family.
-            if r["peer"]:
-                key = "_".join(name.split("_")[:2 if not name.startswith("scipy_rbf") else 3])
-            elif int(r["degree"]) not in (1, 2) and not name.startswith("sph"):
-                continue
-            series.setdefault(key, []).append((r["n"], r["rms_error"], r))
+            if r["peer"] == 0:
+                fam = name.split("_")[0]
+                d = int(r["degree"])
+                if not ((fam == "mls" and d >= 1) or (fam == "pu-wls" and d >= 2) or fam == "sph"):
+                    continue
+            series.setdefault(family(r), []).append((r["n"], r["rms_error"], r))
+        peers = 0
         for key, pts in sorted(series.items()):
             pts.sort(key=lambda p: p[0])
-            c, m, ours = _style(pts[0][2])
+            c, m, ours = _series_style(key, pts[0][2], peers)
+            peers += 0 if ours else 1
             ax.plot([p[0] for p in pts], [max(p[1], 1e-16) for p in pts], color=c, marker=m, lw=1.6 if ours else 0.8,
                     ms=4, ls="-" if ours else "--", label=key)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("N (data points)")
         ax.set_ylabel("rms error")
-        ax.set_title("convergence, %s" % field, fontsize=10)
+        ax.set_title("approximation convergence, %s (local methods)" % field, fontsize=10)
         ax.grid(True, lw=0.3)
-        ax.legend(fontsize=5.5, ncol=2, frameon=False)
+        ax.legend(fontsize=6, ncol=2, frameon=False)
     k = len(panels)
     if sph:
         ax = axes[k]
@@ -271,28 +304,29 @@ def plot_convergence(rows, path, fields=("F1", "F1_3d"), sph=None, solid=None):
         for case, m in (("dam_break", "o"), ("hydrostatic", "s")):
             pts = sorted((r["resolution"], r["rms_error"]) for r in sph if r["case"] == case)
             if pts:
-                ax.plot(*zip(*pts), marker=m, label={"dam_break": "dam-break front vs Martin & Moyce",
+                ax.plot(*zip(*pts), marker=m, label={"dam_break": "dam-break front vs Martin & Moyce (rms rel.)",
                                                      "hydrostatic": "hydrostatic pressure (rel. L2)"}[case])
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("resolution (particles per column width / height)")
-        ax.set_ylabel("relative rms error")
-        ax.set_title("SPH fluid (2D)", fontsize=10)
-        ax.grid(True, lw=0.3)
+        ax.set_xlabel("resolution (particles across the column width a / height H)")
+        ax.set_ylabel("relative error")
+        ax.set_title("SPH fluid, 2D", fontsize=10)
+        ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=7, frameon=False)
     if solid:
         ax = axes[k]
         for integ, m in (("SymplecticEuler", "o"), ("Implicit", "s")):
-            pts = sorted((r["resolution"], r["rms_error"]) for r in solid
+            pts = sorted((r["resolution"], r["rms_error"], r["max_error"]) for r in solid
                          if r["case"] == "cantilever" and r["integrator"] == integ)
             if pts:
-                ax.plot(*zip(*pts), marker=m, label=integ)
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=m, label=integ + " (rms over the beam)")
+                ax.plot([p[0] for p in pts], [p[2] for p in pts], marker=m, ls=":", label=integ + " (max)")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("phyxels across the beam")
-        ax.set_ylabel("relative tip-deflection error")
-        ax.set_title("MLS solid cantilever vs Euler-Bernoulli + shear", fontsize=9)
-        ax.grid(True, lw=0.3)
+        ax.set_ylabel("deflection error / reference tip deflection")
+        ax.set_title("MLS solid cantilever vs Euler-Bernoulli + shear", fontsize=10)
+        ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=7, frameon=False)
     fig.tight_layout()
     fig.savefig(path, dpi=80)
@@ -325,13 +359,14 @@ def plot_scaling(approx, sph, solid, path):
         f, name = split_method(r["method"])
         if f != "F1":
             continue
-        if r["peer"] == 0 and not (name.startswith("mls") and int(r["degree"]) in (1, 2)):
+        if r["peer"] == 0 and not (name.startswith("mls") and int(r["degree"]) in (1, 2, 3)):
             continue
-        key = label(r) if r["peer"] == 0 else "_".join(name.split("_")[:2 if not name.startswith("scipy_rbf") else 3])
-        series.setdefault(key, []).append((r["n"], r["evals_per_second"], r))
+        series.setdefault(family(r), []).append((r["n"], r["evals_per_second"], r))
+    peers = 0
     for key, pts in sorted(series.items()):
         pts.sort(key=lambda p: p[0])
-        c, m, ours = _style(pts[0][2])
+        c, m, ours = _series_style(key, pts[0][2], peers)
+        peers += 0 if ours else 1
         ax.plot([p[0] for p in pts], [p[1] for p in pts], color=c, marker=m, ls="-" if ours else "--",
                 lw=1.6 if ours else 0.8, ms=4, label=key)
     ax.set_xscale("log")
