@@ -96,6 +96,28 @@ int vtkMeshFreeKernelSource::RequestData(
     gradient->SetTuple(i, g);
     laplacian->SetValue(i, kernel.Laplacian(r));
   }
+  // A tiny support or epsilon can push the Laplacian (1/h^(d+2), 1/eps^4) past double's range at the centre:
+  // such values are clamped to +-VTK_DOUBLE_MAX, never Inf or NaN.
+  vtkIdType clamped = 0;
+  for (vtkDataArray* array : { static_cast<vtkDataArray*>(value), static_cast<vtkDataArray*>(gradient),
+         static_cast<vtkDataArray*>(laplacian) })
+  {
+    double* v = static_cast<vtkDoubleArray*>(array)->GetPointer(0);
+    const vtkIdType count = array->GetNumberOfValues();
+    for (vtkIdType i = 0; i < count; ++i)
+    {
+      if (!std::isfinite(v[i]))
+      {
+        v[i] = std::isnan(v[i]) ? 0.0 : std::copysign(VTK_DOUBLE_MAX, v[i]);
+        ++clamped;
+      }
+    }
+  }
+  if (clamped > 0)
+  {
+    vtkWarningMacro(<< clamped << " kernel values overflow double (support radius " << this->SupportRadius
+                    << ", epsilon " << this->Epsilon << "): they are clamped to +-VTK_DOUBLE_MAX.");
+  }
   output->GetPointData()->AddArray(value);
   output->GetPointData()->AddArray(gradient);
   output->GetPointData()->AddArray(laplacian);

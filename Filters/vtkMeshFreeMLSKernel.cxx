@@ -3,11 +3,14 @@
 #include "vtkDataSet.h"
 #include "vtkDoubleArray.h"
 #include "vtkIdList.h"
+#include "vtkDataArray.h"
+#include "vtkPointData.h"
 #include "vtkObjectFactory.h"
 
 #include "Approximation.h"
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 vtkStandardNewMacro(vtkMeshFreeMLSKernel);
@@ -75,11 +78,37 @@ void vtkMeshFreeMLSKernel::Initialize(vtkAbstractPointLocator* loc, vtkDataSet* 
   {
     ds->GetPoint(i, &xyz[3 * i]);
   }
+  // vtkPointInterpolator sums weight x value for every source array: a source point with a NaN/Inf value
+  // in any of them would make the result NaN, so such points get no weight (as NaN/Inf coordinates).
+  vtkIdType badValues = 0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int a = 0; pd && a < pd->GetNumberOfArrays(); ++a)
+  {
+    vtkDataArray* array = pd->GetArray(a);
+    if (!array || array->GetNumberOfTuples() != n)
+    {
+      continue;
+    }
+    const int nc = array->GetNumberOfComponents();
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      for (int c = 0; c < nc; ++c)
+      {
+        if (!std::isfinite(array->GetComponent(i, c)))
+        {
+          badValues += std::isfinite(xyz[3 * i]) ? 1 : 0;
+          xyz[3 * i] = xyz[3 * i + 1] = xyz[3 * i + 2] = nan;
+          break;
+        }
+      }
+    }
+  }
   this->Core->Approx.SetCloud(xyz.data(), n, nullptr, 0);
   if (this->Core->Approx.Report().ExcludedPoints > 0)
   {
     vtkWarningMacro(<< this->Core->Approx.Report().ExcludedPoints
-                    << " source points have NaN/Inf coordinates: they are ignored.");
+                    << " source points have NaN/Inf coordinates or values (" << badValues
+                    << " of them values): they are ignored.");
   }
   this->Core->Ready = this->Core->Approx.PrepareShapeFunctions();
   if (!this->Core->Ready)

@@ -114,8 +114,24 @@ bool vtkMeshlessApproximation::GridGeometry(
   }
   else if (input && input->GetNumberOfPoints() > 0)
   {
-    // vtkPoints::GetBounds skips NaN coordinates.
-    input->GetPoints()->GetBounds(bounds);
+    // The bounds of the finite points (vtkPoints::GetBounds skips NaN but not Inf, and one Inf point
+    // would collapse an axis of the grid).
+    bool any = false;
+    for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
+    {
+      double x[3];
+      input->GetPoint(i, x);
+      if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+      {
+        continue;
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        bounds[2 * a] = any ? std::min(bounds[2 * a], x[a]) : x[a];
+        bounds[2 * a + 1] = any ? std::max(bounds[2 * a + 1], x[a]) : x[a];
+      }
+      any = true;
+    }
   }
   for (int a = 0; a < 3; ++a)
   {
@@ -301,6 +317,11 @@ int vtkMeshlessApproximation::RequestData(
   opts.ComputeGradients = this->ComputeGradients;
   opts.Diagnostics = this->Diagnostics;
   opts.NullValue = this->NullValue;
+  if (!std::isfinite(this->NullValue))
+  {
+    vtkWarningMacro("NullValue " << this->NullValue << " is not a finite number: masked points get 0 instead.");
+    opts.NullValue = 0.0;
+  }
   meshfree::Approximator approx;
   if (!approx.SetOptions(opts))
   {
@@ -366,7 +387,7 @@ int vtkMeshlessApproximation::RequestData(
   {
     span = std::max(span, cloudBounds[2 * a + 1] - cloudBounds[2 * a]);
   }
-  vtkIdType outside = 0;
+  vtkIdType outside = 0, nonFinite = 0;
   for (vtkIdType i = 0; i < m; ++i)
   {
     double* x = &eval[3 * i];
@@ -374,6 +395,11 @@ int vtkMeshlessApproximation::RequestData(
     if (this->HeightField)
     {
       x[2] = 0.0;
+    }
+    if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+    {
+      ++nonFinite; // masked by the evaluation
+      continue;
     }
     for (int a = 0; a < 3; ++a)
     {
@@ -383,6 +409,12 @@ int vtkMeshlessApproximation::RequestData(
         break;
       }
     }
+  }
+  if (nonFinite > 0)
+  {
+    vtkWarningMacro(<< nonFinite << " of " << m
+                    << " output (probe) points have NaN/Inf coordinates: they get NullValue and "
+                       "vtkValidPointMask = 0 (their coordinates are the probe's, passed through).");
   }
   if (outside > 0 && valid > 0)
   {
@@ -413,11 +445,12 @@ int vtkMeshlessApproximation::RequestData(
   const meshfree::ApproximationReport& report = approx.Report();
   if (!done && !report.Aborted && valid > 0)
   {
-    vtkWarningMacro("Approximation failed (" << approx.Error() << "): every output point is masked.");
+    vtkWarningMacro("Approximation failed (" << approx.Error()
+                                             << "): every output point gets NullValue and vtkValidPointMask = 0.");
   }
-  else if (report.Masked > 0 && valid > 0 && !report.Aborted)
+  else if (report.Masked > nonFinite && valid > 0 && !report.Aborted)
   {
-    vtkWarningMacro(<< report.Masked << " of " << m
+    vtkWarningMacro(<< report.Masked - nonFinite << " of " << m
                     << " output points could not be evaluated (no input point within the support, or a "
                        "degenerate fit after every fallback): they get NullValue and vtkValidPointMask = 0.");
   }

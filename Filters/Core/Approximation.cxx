@@ -163,12 +163,20 @@ bool Approximator::SetCloud(
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
   const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0); // ascending
   const double largest = lambda(2);
+  // Rounding noise of the centred coordinates: identical points whose mean is not exactly representable
+  // still give a tiny non-zero covariance (~(1e-16 |c|)^2), which is no extent at all.
+  double magnitude = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    magnitude = std::max({ magnitude, std::fabs(c[a]), this->Bounds[2 * a + 1] - this->Bounds[2 * a] });
+  }
+  const double noise = (1e-14 * magnitude) * (1e-14 * magnitude);
   int dim = 0;
   for (int a = 0; a < 3; ++a)
   {
     // Standard deviation below ~3e-7 of the largest: flat. (The eigen-solver's absolute accuracy is about
     // 1e-16 of the largest eigenvalue, so a smaller variance ratio cannot be told from zero.)
-    dim += (largest > 0.0 && lambda(a) > 1e-13 * largest) ? 1 : 0;
+    dim += (largest > noise && lambda(a) > 1e-13 * largest) ? 1 : 0;
   }
   this->Frame = LocalFrame();
   this->Frame.Dimension = dim;

@@ -186,7 +186,8 @@ private:
   std::vector<double> Coordinates;
   std::vector<double> Values;
   std::vector<double> Volumes;    // given V_j = m_j / rho_j (SPH)
-  std::vector<double> SphVolumes; // the volumes SPH uses (given or estimated)
+  std::vector<double> SphVolumes; // the volumes SPH uses (given or estimated), in units of SphUnitLength^d
+  double SphUnitLength = 1.0;     // so that neither h^d nor 1/h^d over- or underflows for extreme scales
   int NumberOfComponents = 0;
   double Bounds[6] = { 0, 0, 0, 0, 0, 0 };
   double CloudCenter[3] = { 0, 0, 0 };

@@ -65,13 +65,26 @@ bool Approximator::PreparePU()
       spacing = std::pow(k / (density * omega * std::pow(static_cast<double>(D), 0.5 * D)), 1.0 / D);
       cover = spacing * std::sqrt(static_cast<double>(D));
     }
+    if (!(spacing > 0.0) || !std::isfinite(spacing))
+    {
+      // A cloud without extent along some axis of its frame (or an overflowing one): one cover patch per
+      // axis-length, so that the node count below stays finite and positive.
+      double extent = 0.0;
+      for (int a = 0; a < D; ++a)
+      {
+        extent = std::max(extent, umax[a] - umin[a]);
+      }
+      spacing = extent > 0.0 && std::isfinite(extent) ? extent : 1.0;
+      cover = spacing * std::sqrt(static_cast<double>(D));
+    }
     for (;;)
     {
       double total = 1.0;
       for (int a = 0; a < D; ++a)
       {
-        counts[a] = static_cast<Index>(std::ceil((umax[a] - umin[a]) / spacing)) + 1;
-        total *= static_cast<double>(counts[a]);
+        const double cells = std::ceil((umax[a] - umin[a]) / spacing);
+        counts[a] = (cells >= 0.0 && cells < 1e15) ? static_cast<Index>(cells) + 1 : 1;
+        total *= cells >= 0.0 ? cells + 1.0 : std::numeric_limits<double>::infinity();
       }
       if (total <= 4.0 * static_cast<double>(nv) + 64.0 && std::isfinite(total))
       {

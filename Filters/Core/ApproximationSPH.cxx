@@ -11,15 +11,35 @@ namespace meshfree
 bool Approximator::PrepareSPHVolumes()
 {
   const Index n = static_cast<Index>(this->Coordinates.size() / 3);
+  const int dim = std::max(1, this->Frame.Dimension);
+  // Volumes are kept relative to a unit volume SphUnitLength^d of the cloud's own scale: with a support of
+  // 1e200 (or a cloud scaled by 1e-200) h^d and 1/h^d leave double's range, their ratios do not.
   if (this->Volumes.size() == static_cast<size_t>(n))
   {
-    this->SphVolumes = this->Volumes;
+    double largest = 0.0;
+    for (double v : this->Volumes)
+    {
+      largest = std::isfinite(v) ? std::max(largest, v) : largest;
+    }
+    this->SphUnitLength = largest > 0.0 ? std::pow(largest, 1.0 / dim) : 1.0;
+    this->SphVolumes.resize(this->Volumes.size());
+    for (size_t i = 0; i < this->Volumes.size(); ++i)
+    {
+      this->SphVolumes[i] = largest > 0.0 ? this->Volumes[i] / largest : this->Volumes[i];
+    }
     return true;
   }
+  double extent = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    extent = std::max(extent, this->Bounds[2 * a + 1] - this->Bounds[2 * a]);
+  }
+  double unit = this->Opts.SupportRadius > 0.0 ? this->Opts.SupportRadius : extent;
+  this->SphUnitLength = unit > 0.0 && std::isfinite(unit) ? unit : 1.0;
   // No Mass/Density: V_j = 1 / sum_k W(|x_j - x_k|, h_j), the inverse number density, with h_j from the
   // same support rule as the evaluation (the point itself is included, so the sum is >= W(0) > 0).
   this->SphVolumes.assign(static_cast<size_t>(n), 0.0);
-  const int dim = std::max(1, this->Frame.Dimension);
+  const double unitLength = this->SphUnitLength;
   const std::vector<Index>& order = this->Points.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
 #pragma omp parallel
@@ -38,7 +58,7 @@ bool Approximator::PrepareSPHVolumes()
       {
         sum += this->UnitKernel.ValueSquared(s.Dist2[j] * invH2);
       }
-      const double hd = std::pow(h, dim);
+      const double hd = std::pow(h / unitLength, dim);
       this->SphVolumes[id] = sum > 0.0 ? hd / sum : 0.0;
     }
   }
@@ -62,7 +82,9 @@ Approximator::PointResult Approximator::SPHPoint(
     const int n = this->Neighbors(x, k, radius, s, h);
     s.Reserve(static_cast<size_t>(std::max(n, 1)));
     const double invH = 1.0 / h;
-    const double invHd = 1.0 / std::pow(h, dim);
+    // (unit / h)^d: the volumes are in units of unit^d. Shepard normalisation divides out any factor common
+    // to every neighbour, so it is left out there (no underflow for a support far larger than the cloud).
+    const double invHd = shepard ? 1.0 : std::pow(this->SphUnitLength / h, dim);
     int m = 0;
     double sum = 0.0;
     double sumGrad[3] = { 0, 0, 0 };

@@ -3,6 +3,7 @@
 #include "Kernels.h"
 
 #include <cctype>
+#include <cstdio>
 #include <stdexcept>
 
 namespace meshfree
@@ -169,7 +170,10 @@ Kernel::Kernel(KernelType type, int dimension, double supportRadius, double epsi
   this->InverseRadius = 1.0 / supportRadius;
   this->InverseRadiusSquared = this->InverseRadius * this->InverseRadius;
   this->RelativeEpsilon = epsilon;
-  this->EpsilonSquared = epsilon * epsilon;
+  // InverseDistance: W(0) = 1/eps^2 must stay finite, with room for sums of many weights and for the
+  // moment matrices built from them: eps below kMinimumEpsilon acts as kMinimumEpsilon (then W(0) = 1e100,
+  // the fit interpolates the data to ~1e-100 relative, as eps -> 0 should).
+  this->EpsilonSquared = std::max(epsilon, kMinimumEpsilon) * std::max(epsilon, kMinimumEpsilon);
   this->GaussExponent = 0.0;
   this->TaperOffset = 0.0;
   if (type == KernelType::Gaussian || type == KernelType::W2)
@@ -204,6 +208,19 @@ Kernel::Kernel(KernelType type, int dimension, double supportRadius, double epsi
   }
   this->DerivativeNormalization = this->Normalization * this->InverseRadius;
   this->LaplacianNormalization = this->Normalization * this->InverseRadiusSquared;
+  // sigma/h^d and its /h, /h^2 versions must be representable: a support of 1e-300 in 3D overflows them (and
+  // 0 * inf would give NaN), one of 1e300 underflows sigma/h^d to 0 (a kernel that is zero everywhere).
+  if (!std::isfinite(this->Normalization) || !std::isfinite(this->DerivativeNormalization) ||
+    !std::isfinite(this->LaplacianNormalization) || !std::isfinite(this->InverseRadiusSquared) ||
+    !(this->Normalization > 0.0))
+  {
+    char text[160];
+    std::snprintf(text, sizeof text,
+      "meshfree::Kernel: support radius %g is out of range in dimension %d (the normalisation sigma/h^d or "
+      "its derivatives over- or underflow)",
+      supportRadius, dimension);
+    throw std::invalid_argument(text);
+  }
 }
 
 //------------------------------------------------------------------------------

@@ -91,7 +91,9 @@ public:
   Kernel() = default;
 
   /// Throws std::invalid_argument for an unknown type, a dimension outside 1..3, a support radius that is not
-  /// finite and > 0, or (InverseDistance only, ignored otherwise) an epsilon that is not finite and > 0.
+  /// finite and > 0 or so extreme that sigma/h^d (or its /h, /h^2 versions) leaves double's range, or
+  /// (InverseDistance only, ignored otherwise) an epsilon that is not finite and > 0. Epsilon below
+  /// kMinimumEpsilon acts as kMinimumEpsilon.
   Kernel(KernelType type, int dimension, double supportRadius, double epsilon = 1e-3);
 
   KernelType Type() const { return this->Kind; }
@@ -118,6 +120,8 @@ public:
 
   /// Below this q the singular kernels (Viscosity, Spiky's Laplacian) are evaluated at q = kMinimumQ.
   static constexpr double kMinimumQ = 1e-6;
+  /// InverseDistance: a smaller epsilon acts as this one (1/eps^2 = 1e100 stays finite in sums and fits).
+  static constexpr double kMinimumEpsilon = 1e-50;
 
 private:
   double Shape(double q) const;           // f(q), 0 <= q < 1
