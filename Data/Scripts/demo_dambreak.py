@@ -49,6 +49,20 @@ def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
     lut.ApplyPreset("Jet", True)
     lut.RescaleTransferFunction(0.0, 3.0)
     display.SetScalarBarVisibility(view, True)
+    # The default scalar bar text is white: invisible on the white background. Black title and labels.
+    bar = simple.GetScalarBar(lut, view)
+    bar.Title = "speed"
+    bar.ComponentTitle = "(m/s)"
+    bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
+    bar.TitleFontSize = 18
+    bar.LabelFontSize = 16
+    bar.DrawTickLabels = 1
+    bar.AddRangeLabels = 1
+    bar.RangeLabelFormat = "%-#.1f"
+    bar.LabelFormat = "%-#.1f"
+    bar.UseCustomLabels = 1
+    bar.CustomLabels = [0.5, 1.0, 1.5, 2.0, 2.5]
+    bar.ScalarBarLength = 0.5
     view.CameraPosition = [0.8, -1.5, 0.8]
     view.CameraFocalPoint = [0.8, 0.16, 0.12]
     view.CameraViewUp = [0, 0, 1]

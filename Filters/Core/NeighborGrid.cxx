@@ -1258,6 +1258,155 @@ int NeighborGrid::FindKNearest(
   return count;
 }
 
+bool NeighborGrid::FindWithinRadiusForAllPoints(
+  double radius, std::vector<Index>& offsets, std::vector<std::int32_t>& ids, bool excludeSelf) const
+{
+  const Index n = this->NumberOfInputPoints;
+  offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  ids.clear();
+  const Index valid = static_cast<Index>(this->Order.size());
+  if (n >= (Index(1) << 31))
+  {
+    return false;
+  }
+  if (valid == 0 || !(radius >= 0.0) || !std::isfinite(radius))
+  {
+    return true;
+  }
+  const double r2 = radius * radius;
+  const double* xyz = this->Sorted.data();
+  const Index* order = this->Order.data();
+  const CellRange* cells = this->CellRanges.data();
+  const Index nx = this->GridDims[0], ny = this->GridDims[1], nz = this->GridDims[2];
+  const Index cellCount = nx * ny * nz;
+  const int threads = omp_get_max_threads();
+  // Scratch kept per thread between calls (repeated calls, e.g. every step of a simulation, then neither
+  // allocate nor touch fresh pages): per sorted position, where its row lies in its thread's buffer.
+  thread_local detail::Buffer<Index> rowStart;
+  thread_local detail::Buffer<std::int32_t> rowThread;
+  rowStart.resize(static_cast<std::size_t>(valid));
+  rowThread.resize(static_cast<std::size_t>(valid));
+  Index* rowStartData = rowStart.data();
+  std::int32_t* rowThreadData = rowThread.data();
+  std::vector<const std::int32_t*> buffers(static_cast<std::size_t>(threads), nullptr);
+#pragma omp parallel num_threads(threads) if (valid >= 4096)
+  {
+    const int t = omp_get_thread_num();
+    thread_local detail::Buffer<std::int32_t> out; // this thread's rows, back to back
+    std::size_t used = 0; // out.size() is the capacity in use; rows are written branch-free past `used`
+    // Candidate cells of the current cell (neighbouring ranges merged), and the filter's outputs.
+    thread_local std::vector<CellRange> ranges;
+    thread_local detail::Buffer<double> dist2;
+    thread_local detail::Buffer<Index> pos;
+#pragma omp for schedule(dynamic, 64)
+    for (Index c = 0; c < cellCount; ++c)
+    {
+      const CellRange own = cells[c];
+      if (own.End <= own.Begin)
+      {
+        continue;
+      }
+      // The cells any of this cell's points can reach: the per-point range of VisitCells() for the box of
+      // the cell's points, visited in the same (z, y, x) order, so every row keeps FindWithinRadius()'s order
+      // (cells VisitCells() would prune hold no point within the radius).
+      double lo[3], hi[3];
+      for (int a = 0; a < 3; ++a)
+      {
+        lo[a] = hi[a] = xyz[3 * own.Begin + a] - this->Origin[a];
+      }
+      for (Index p = own.Begin + 1; p < own.End; ++p)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          const double rel = xyz[3 * p + a] - this->Origin[a];
+          lo[a] = std::min(lo[a], rel);
+          hi[a] = std::max(hi[a], rel);
+        }
+      }
+      const double margin =
+        std::max(GapMargin(lo, this->Size, this->Extent), GapMargin(hi, this->Size, this->Extent));
+      Index first[3], last[3];
+      bool none = false;
+      for (int a = 0; a < 3; ++a)
+      {
+        const double top = static_cast<double>(this->GridDims[a] - 1);
+        const double low = std::floor((lo[a] - radius - margin) * this->InverseSize);
+        const double high = std::floor((hi[a] + radius + margin) * this->InverseSize);
+        none = none || low > top || high < 0.0;
+        first[a] = low > 0.0 ? static_cast<Index>(low) : 0;
+        last[a] = high < top ? static_cast<Index>(high) : this->GridDims[a] - 1;
+      }
+      ranges.clear();
+      Index total = 0;
+      for (Index k = first[2]; !none && k <= last[2]; ++k)
+      {
+        for (Index j = first[1]; j <= last[1]; ++j)
+        {
+          const CellRange* row = cells + nx * (j + ny * k);
+          for (Index i = first[0]; i <= last[0]; ++i)
+          {
+            const CellRange range = row[i];
+            if (range.End <= range.Begin)
+            {
+              continue;
+            }
+            total += range.End - range.Begin;
+            if (!ranges.empty() && ranges.back().End == range.Begin)
+            {
+              ranges.back().End = range.End;
+            }
+            else
+            {
+              ranges.push_back(range);
+            }
+          }
+        }
+      }
+      if (static_cast<Index>(dist2.size()) < total + 8)
+      {
+        dist2.resize(static_cast<std::size_t>(2 * total + 8));
+        pos.resize(static_cast<std::size_t>(2 * total + 8));
+      }
+      for (Index p = own.Begin; p < own.End; ++p)
+      {
+        const int found = ranges.empty()
+          ? 0
+          : Filter(xyz, ranges.data(), static_cast<int>(ranges.size()), xyz + 3 * p, r2, dist2.data(), pos.data());
+        if (out.size() < used + static_cast<std::size_t>(found))
+        {
+          out.resize(2 * (used + static_cast<std::size_t>(found)));
+        }
+        std::int32_t* row = out.data() + used;
+        std::size_t m = 0;
+        for (int q = 0; q < found; ++q) // branch-free: the count decides
+        {
+          row[m] = static_cast<std::int32_t>(order[pos[q]]);
+          m += static_cast<std::size_t>(!(excludeSelf && pos[q] == p));
+        }
+        rowStartData[p] = static_cast<Index>(used);
+        rowThreadData[p] = t;
+        offsets[static_cast<std::size_t>(order[p]) + 1] = static_cast<Index>(m);
+        used += m;
+      }
+    }
+    buffers[static_cast<std::size_t>(t)] = out.data();
+  }
+  for (Index i = 0; i < n; ++i)
+  {
+    offsets[static_cast<std::size_t>(i) + 1] += offsets[static_cast<std::size_t>(i)];
+  }
+  ids.resize(static_cast<std::size_t>(offsets[static_cast<std::size_t>(n)]));
+#pragma omp parallel for schedule(static) if (valid >= 4096)
+  for (Index p = 0; p < valid; ++p)
+  {
+    const Index i = order[p];
+    const std::int32_t* from = buffers[static_cast<std::size_t>(rowThreadData[p])] + rowStartData[p];
+    std::copy(from, from + (offsets[static_cast<std::size_t>(i) + 1] - offsets[static_cast<std::size_t>(i)]),
+      ids.begin() + offsets[static_cast<std::size_t>(i)]);
+  }
+  return true;
+}
+
 void NeighborGrid::FindKNearestForAllPoints(
   int k, std::vector<Index>& ids, std::vector<double>& dist2) const
 {

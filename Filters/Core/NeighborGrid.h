@@ -159,6 +159,16 @@ public:
   /// FindKNearest() at each point.
   void FindKNearestForAllPoints(int k, std::vector<Index>& ids, std::vector<double>& dist2) const;
 
+  /// The radius neighbours of every valid point at once, computed cell by cell in parallel: the candidate
+  /// cells of a cell are gathered once into a contiguous buffer shared by all its points. Row i (ids
+  /// [offsets[i], offsets[i + 1])) belongs to input point i and holds the original indices of the valid
+  /// points with d2 <= radius^2, in the order FindWithinRadius() at point i returns them, without point i
+  /// itself when excludeSelf is set. offsets gets NumberOfPoints() + 1 entries; rows of invalid points are
+  /// empty, and a NaN or negative radius gives empty rows. Indices are 32-bit: NumberOfPoints() must be
+  /// below 2^31 (otherwise every row is empty and false is returned).
+  bool FindWithinRadiusForAllPoints(
+    double radius, std::vector<Index>& offsets, std::vector<std::int32_t>& ids, bool excludeSelf = false) const;
+
   ///@{
   /// The Morton-sorted layout. SortedOrder()[s] is the original index of the point at sorted position s
   /// (valid points only); SortedPoints() holds their coordinates, interleaved x, y, z, in that order.

@@ -22,19 +22,23 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
 {
   const Index n = state.Size();
   const double* x = state.Position.data();
-  const int threads = omp_get_max_threads();
-  this->ThreadFluid.resize(threads);
-  this->ThreadBoundary.resize(threads);
-  this->FluidStart.assign(n + 1, 0);
+  // Fluid neighbours: one batched query over the grid's cells (the 27 candidate cells of a cell are gathered
+  // once for all its particles), rows in the order of a per-particle query, the particle itself left out.
+  this->Grid.FindWithinRadiusForAllPoints(this->H, this->FluidStart, this->FluidNeighbors, true);
   this->BoundaryStart.assign(n + 1, 0);
-  std::vector<Index> firstOfThread(threads, n);
   const bool boundary = withBoundary && this->BoundaryCount > 0;
+  if (!boundary)
+  {
+    this->BoundaryNeighbors.clear();
+    return;
+  }
+  const int threads = omp_get_max_threads();
+  this->ThreadBoundary.resize(threads);
+  std::vector<Index> firstOfThread(threads, n);
 #pragma omp parallel if (n >= ParallelThreshold)
   {
     const int t = omp_get_thread_num();
-    std::vector<std::int32_t>& fluid = this->ThreadFluid[t];
     std::vector<std::int32_t>& wall = this->ThreadBoundary[t];
-    fluid.clear();
     wall.clear();
     std::vector<Index> ids;
     ids.reserve(256);
@@ -47,18 +51,7 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
       {
         firstOfThread[t] = i;
       }
-      this->Grid.FindWithinRadius(x + 3 * i, this->H, ids);
-      Index c = 0;
-      for (Index j : ids)
-      {
-        if (j != i)
-        {
-          fluid.push_back(static_cast<std::int32_t>(j));
-          ++c;
-        }
-      }
-      this->FluidStart[i + 1] = c;
-      if (boundary && this->NearBoundary(x + 3 * i))
+      if (this->NearBoundary(x + 3 * i))
       {
         this->BoundaryGrid.FindWithinRadius(x + 3 * i, this->H, ids);
         for (Index b : ids)
@@ -71,18 +64,14 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
   }
   for (Index i = 0; i < n; ++i)
   {
-    this->FluidStart[i + 1] += this->FluidStart[i];
     this->BoundaryStart[i + 1] += this->BoundaryStart[i];
   }
-  this->FluidNeighbors.resize(this->FluidStart[n]);
   this->BoundaryNeighbors.resize(this->BoundaryStart[n]);
 #pragma omp parallel if (n >= ParallelThreshold)
   {
     const int t = omp_get_thread_num();
     if (firstOfThread[t] < n)
     {
-      std::copy(this->ThreadFluid[t].begin(), this->ThreadFluid[t].end(),
-        this->FluidNeighbors.begin() + this->FluidStart[firstOfThread[t]]);
       std::copy(this->ThreadBoundary[t].begin(), this->ThreadBoundary[t].end(),
         this->BoundaryNeighbors.begin() + this->BoundaryStart[firstOfThread[t]]);
     }

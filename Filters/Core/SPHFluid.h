@@ -60,8 +60,9 @@
 // requested times (the last two steps before a target share the remaining time rather than leave a sliver).
 //
 // Storage is structure of arrays: one array per attribute (position and velocity are xyz triplets, the layout
-// the shared NeighborGrid reads). Neighbour lists are rebuilt every step from the grid (one query per particle,
-// then every pass streams through the lists). Every ReorderInterval steps the particle arrays are permuted into
+// the shared NeighborGrid reads). Neighbour lists are rebuilt every step from the grid with its batched query
+// (NeighborGrid::FindWithinRadiusForAllPoints: cell by cell, the candidate cells gathered once for all the
+// particles of a cell; rows identical to per-particle queries), then every pass streams through the lists. Every ReorderInterval steps the particle arrays are permuted into
 // the grid's Z-order so that neighbours are close in memory. Everything the future depends on is in SPHState, so
 // a state restored from a cache continues bit-identically, whatever the number of threads.
 #ifndef meshfree_SPHFluid_h
@@ -254,7 +255,7 @@ private:
   NeighborGrid Grid;
   std::vector<Index> FluidStart, BoundaryStart;
   std::vector<std::int32_t> FluidNeighbors, BoundaryNeighbors;
-  std::vector<std::vector<std::int32_t>> ThreadFluid, ThreadBoundary;
+  std::vector<std::vector<std::int32_t>> ThreadBoundary;
 };
 
 } // namespace meshfree

@@ -5,6 +5,7 @@
 #include "NeighborGrid.h"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -679,5 +680,147 @@ TEST(NeighborGrid, LargeCloudBuildsInParallelLikeSerial)
   NeighborGrid grid;
   ASSERT_TRUE(grid.Build(c.data(), Count(c)));
   ExpectAllMatch(grid, c, Queries(c, 4000, 10, 30), Spacing(grid));
+}
+
+// FindWithinRadiusForAllPoints(): every row against brute force as an exact index set, and against
+// FindWithinRadius() at that point in order (the rows keep the per-point query's order).
+void ExpectAllRowsMatch(const NeighborGrid& grid, const Cloud& c, double radius, bool excludeSelf)
+{
+  std::vector<Index> offsets;
+  std::vector<std::int32_t> rows;
+  ASSERT_TRUE(grid.FindWithinRadiusForAllPoints(radius, offsets, rows, excludeSelf));
+  ASSERT_EQ(offsets.size(), static_cast<std::size_t>(Count(c)) + 1);
+  ASSERT_EQ(offsets.front(), 0);
+  ASSERT_EQ(static_cast<std::size_t>(offsets.back()), rows.size());
+  const double r2 = radius * radius;
+  std::vector<Index> ids;
+  for (Index i = 0; i < Count(c); ++i)
+  {
+    ASSERT_LE(offsets[i], offsets[i + 1]);
+    const std::vector<Index> row(rows.begin() + offsets[i], rows.begin() + offsets[i + 1]);
+    if (!Valid(&c[3 * i]))
+    {
+      EXPECT_TRUE(row.empty()) << "invalid point " << i;
+      continue;
+    }
+    std::vector<Index> expected;
+    for (Index j = 0; j < Count(c); ++j)
+    {
+      if (Valid(&c[3 * j]) && Distance2(&c[3 * j], &c[3 * i]) <= r2 && !(excludeSelf && j == i))
+      {
+        expected.push_back(j);
+      }
+    }
+    std::vector<Index> sorted = row;
+    std::sort(sorted.begin(), sorted.end());
+    ASSERT_EQ(sorted, expected) << "point " << i << ", radius " << radius;
+    grid.FindWithinRadius(&c[3 * i], radius, ids);
+    if (excludeSelf)
+    {
+      ids.erase(std::remove(ids.begin(), ids.end(), i), ids.end());
+    }
+    ASSERT_EQ(row, ids) << "order differs from FindWithinRadius at point " << i;
+  }
+}
+
+TEST(NeighborGrid, AllPointsRadiusListsMatchBruteForce)
+{
+  // Uniform, clustered (one tight blob, one loose), flat, on cell boundaries, with duplicates and invalid
+  // points; radii from 0 to beyond the cell size; automatic and explicit cell sizes.
+  std::vector<Cloud> clouds;
+  clouds.push_back(Uniform(1500, 41));
+  {
+    std::mt19937_64 rng(42);
+    Cloud c;
+    for (const double sigma : { 2e-3, 0.1 })
+    {
+      std::normal_distribution<double> g(0.5, sigma);
+      for (int i = 0; i < 600; ++i)
+      {
+        c.insert(c.end(), { g(rng), g(rng), g(rng) });
+      }
+    }
+    clouds.push_back(c);
+  }
+  {
+    Cloud flat = Uniform(1200, 43);
+    for (Index i = 0; i < Count(flat); ++i)
+    {
+      flat[3 * i + 1] = 0.0; // the SPH 2D case: the x-z plane
+    }
+    clouds.push_back(flat);
+  }
+  {
+    Cloud lattice; // exact distances equal to the radii, points on cell faces
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < 9; ++j)
+        for (int k = 0; k < 9; ++k)
+          lattice.insert(lattice.end(), { 0.5 * i, 0.5 * j, 0.5 * k });
+    clouds.push_back(lattice);
+  }
+  {
+    Cloud odd = Uniform(800, 44);
+    odd.insert(odd.end(), { odd[0], odd[1], odd[2], odd[0], odd[1], odd[2] }); // duplicates of point 0
+    odd.insert(odd.end(), { NaN, 0.5, 0.5, 0.5, Inf, 0.5 });                    // two invalid points
+    clouds.push_back(odd);
+  }
+  for (const Cloud& c : clouds)
+  {
+    for (const double cellSize : { 0.0, 0.05, 0.5 })
+    {
+      NeighborGrid grid;
+      ASSERT_TRUE(grid.Build(c.data(), Count(c), cellSize));
+      for (const double radius : { 0.0, 0.01, 0.05, 0.5, 1.0 })
+      {
+        for (const bool excludeSelf : { false, true })
+        {
+          ExpectAllRowsMatch(grid, c, radius, excludeSelf);
+        }
+      }
+    }
+  }
+}
+
+TEST(NeighborGrid, AllPointsRadiusListsInParallelAndDegenerateInput)
+{
+  // Above the parallel threshold: the same rows whatever the number of threads.
+  const Cloud c = Uniform(20000, 45);
+  NeighborGrid grid;
+  ASSERT_TRUE(grid.Build(c.data(), Count(c), 0.04));
+  std::vector<Index> offsets, serialOffsets;
+  std::vector<std::int32_t> rows, serialRows;
+  ASSERT_TRUE(grid.FindWithinRadiusForAllPoints(0.04, offsets, rows, true));
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  ASSERT_TRUE(grid.FindWithinRadiusForAllPoints(0.04, serialOffsets, serialRows, true));
+  omp_set_num_threads(threads);
+  EXPECT_EQ(offsets, serialOffsets);
+  EXPECT_EQ(rows, serialRows);
+  // A sample of rows against brute force.
+  for (Index i = 0; i < Count(c); i += 997)
+  {
+    std::vector<Index> expected;
+    for (Index j = 0; j < Count(c); ++j)
+    {
+      if (j != i && Distance2(&c[3 * j], &c[3 * i]) <= 0.04 * 0.04)
+      {
+        expected.push_back(j);
+      }
+    }
+    std::vector<Index> row(rows.begin() + offsets[i], rows.begin() + offsets[i + 1]);
+    std::sort(row.begin(), row.end());
+    EXPECT_EQ(row, expected) << "point " << i;
+  }
+  // NaN or negative radius, empty grid: empty rows of the right count.
+  EXPECT_TRUE(grid.FindWithinRadiusForAllPoints(NaN, offsets, rows));
+  EXPECT_EQ(offsets.size(), static_cast<std::size_t>(Count(c)) + 1);
+  EXPECT_TRUE(rows.empty());
+  EXPECT_TRUE(grid.FindWithinRadiusForAllPoints(-1.0, offsets, rows));
+  EXPECT_TRUE(rows.empty());
+  NeighborGrid empty;
+  empty.Build(nullptr, 0);
+  EXPECT_TRUE(empty.FindWithinRadiusForAllPoints(1.0, offsets, rows));
+  EXPECT_EQ(offsets.size(), 1u);
+  EXPECT_TRUE(rows.empty());
 }
 } // namespace
