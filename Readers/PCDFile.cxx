@@ -18,23 +18,46 @@ namespace meshfree
 namespace pcd
 {
 
+void* AllocateBulk(std::size_t bytes)
+{
+  // Fresh memory costs one page fault per 4 KB page on first touch; in a virtual machine each fault also
+  // exits to the host, and for a cold read of a binary file those faults, not the copying, were the main
+  // cost (measured: 128 MB touched through 4 KB faults took 3-4 s, through 2 MB pages about 0.1 s).
+  // Large blocks are therefore aligned to 2 MB and offered to transparent huge pages, then prefaulted in
+  // one call. Both are advice: on a kernel without them the pages fault in as usual. free() releases.
+  constexpr std::size_t Huge = std::size_t(2) << 20, Large = std::size_t(4) << 20;
+  if (bytes < Large)
+  {
+    void* p = std::malloc(bytes > 0 ? bytes : 1);
+#ifdef MADV_POPULATE_WRITE
+    constexpr std::size_t Page = 4096;
+    if (p && bytes >= 16 * Page)
+    {
+      const auto begin = (reinterpret_cast<std::uintptr_t>(p) + Page - 1) & ~(Page - 1);
+      const auto end = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(Page - 1);
+      if (end > begin)
+        madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+    }
+#endif
+    return p;
+  }
+  const std::size_t rounded = (bytes + Huge - 1) / Huge * Huge;
+  void* p = std::aligned_alloc(Huge, rounded);
+  if (!p)
+    return nullptr;
+#ifdef MADV_HUGEPAGE
+  madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+#ifdef MADV_POPULATE_WRITE
+  madvise(p, rounded, MADV_POPULATE_WRITE);
+#endif
+  return p;
+}
+
 bool Buffer::Allocate(std::size_t bytes)
 {
-  this->Ptr.reset(static_cast<unsigned char*>(std::malloc(bytes > 0 ? bytes : 1)));
+  this->Ptr.reset(static_cast<unsigned char*>(AllocateBulk(bytes)));
   this->Size = this->Ptr ? bytes : 0;
-#ifdef MADV_POPULATE_WRITE
-  // A large fresh block would otherwise take one page fault per 4 KB on first touch, which in a virtual
-  // machine is the main cost of a cold read of a binary file; the kernel prefaults it in one call instead.
-  // (Advice only: on an older kernel it fails and the pages fault in as usual.)
-  constexpr std::size_t Page = 4096, Large = std::size_t(1) << 20;
-  if (this->Ptr && bytes >= Large)
-  {
-    const auto begin = (reinterpret_cast<std::uintptr_t>(this->Ptr.get()) + Page - 1) & ~(Page - 1);
-    const auto end = (reinterpret_cast<std::uintptr_t>(this->Ptr.get()) + bytes) & ~(Page - 1);
-    if (end > begin)
-      madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
-  }
-#endif
   return this->Ptr != nullptr;
 }
 

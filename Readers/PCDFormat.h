@@ -58,11 +58,17 @@ struct Header
   int FieldIndex(const std::string& name) const; // -1 when absent
 };
 
+/// Memory for a large output array, released with std::free (so a VTK array can adopt it with
+/// VTK_DATA_ARRAY_FREE): blocks of 4 MB and more are 2 MB-aligned, backed by transparent huge pages where
+/// the kernel offers them, and prefaulted, so that filling fresh memory does not pay one page fault per
+/// 4 KB. Null when out of memory.
+void* AllocateBulk(std::size_t bytes);
+
 /// A malloc'ed block, so that a VTK array can adopt it without a copy (VTK_DATA_ARRAY_FREE).
 class Buffer
 {
 public:
-  bool Allocate(std::size_t bytes); // false when out of memory
+  bool Allocate(std::size_t bytes); // AllocateBulk; false when out of memory
   unsigned char* Data() const { return this->Ptr.get(); }
   std::size_t Bytes() const { return this->Size; }
   unsigned char* Release(); // the caller must free() it

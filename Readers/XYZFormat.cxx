@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cstdlib>
 #include <cstring>
+#include <thread>
 
 namespace meshfree
 {
@@ -64,6 +65,176 @@ bool SplitLine(const char* b, const char* e, std::vector<std::pair<const char*, 
       return false;
     }
   }
+  return true;
+}
+
+// A line of the data section that holds a row: not blank, not a comment (# or //).
+inline bool IsRowLine(const char* b, const char* e)
+{
+  while (b < e && IsBlank(*b))
+    ++b;
+  return b < e && *b != '#' && !(e - b >= 2 && b[0] == '/' && b[1] == '/');
+}
+
+// One row of `columns` numbers into out, without building a field list: the hot loop of a large file.
+// False on anything unusual; RowError then says what (with the same rules as SplitLine).
+inline bool FastRow(const char* p, const char* e, std::size_t columns, double* out)
+{
+  while (p < e && IsBlank(*p))
+    ++p;
+  std::size_t k = 0;
+  while (p < e)
+  {
+    const char* t = p;
+    while (p < e && !IsSeparator(*p))
+      ++p;
+    if (p == t || k == columns)
+      return false;
+    const char* b = t + (*t == '+');
+    auto r = std::from_chars(b, p, out[k]);
+    if (r.ec != std::errc() || r.ptr != p)
+    {
+      if (r.ec != std::errc::result_out_of_range)
+        return false;
+      out[k] = std::strtod(std::string(b, p).c_str(), nullptr); // denormal or overflow: still a number
+    }
+    ++k;
+    int hard = 0;
+    for (; p < e && IsSeparator(*p); ++p)
+      hard += (*p == ',' || *p == ';');
+    if (hard > 1 || (hard == 1 && p == e))
+      return false;
+  }
+  return k == columns;
+}
+
+// Rows and newlines in [b, e) (both ends at line boundaries).
+void CountRows(const char* b, const char* e, std::uint64_t& rows, std::size_t& newlines)
+{
+  rows = 0, newlines = 0;
+  while (b < e)
+  {
+    const char* nl = static_cast<const char*>(std::memchr(b, '\n', e - b));
+    const char* le = nl ? nl : e;
+    rows += IsRowLine(b, le);
+    newlines += (nl != nullptr);
+    b = nl ? nl + 1 : e;
+  }
+}
+
+// What is wrong with a row FastRow refused (the messages of the line-by-line rules).
+std::string RowError(const char* b, const char* e, std::size_t columns)
+{
+  std::vector<std::pair<const char*, const char*>> fields;
+  std::string error;
+  if (!SplitLine(b, e, fields, error))
+    return error;
+  if (fields.size() != columns)
+    return std::to_string(fields.size()) + " columns where the cloud has " + std::to_string(columns);
+  for (const auto& f : fields)
+  {
+    double v;
+    if (!ParseDouble(f.first, f.second, v))
+      return "'" + std::string(f.first, std::min<std::ptrdiff_t>(f.second - f.first, 40)) + "' is not a number";
+  }
+  return "unreadable row";
+}
+
+// Parses the rows of [b, e) into out (advance: one row after the other; otherwise every row into the same
+// scratch row, to find the first error without the memory). line: the number of the line before b.
+bool ParseRows(const char* b, const char* e, std::size_t columns, double* out, bool advance, std::size_t line,
+  std::string& error)
+{
+  while (b < e)
+  {
+    const char* nl = static_cast<const char*>(std::memchr(b, '\n', e - b));
+    const char* le = nl ? nl : e;
+    ++line;
+    if (IsRowLine(b, le))
+    {
+      if (!FastRow(b, le, columns, out))
+      {
+        error = "line " + std::to_string(line) + ": " + RowError(b, le, columns);
+        return false;
+      }
+      out += advance ? columns : 0;
+    }
+    b = nl ? nl + 1 : e;
+  }
+  return true;
+}
+
+// The data rows after the first one (already in table.Values): counted, allocated once, parsed in place;
+// large files in pieces split at line boundaries, one thread each. line: the number of the first row's line.
+bool ParseData(const char* b, const char* e, std::size_t columns, std::size_t line, Table& table,
+  std::string& error)
+{
+  const std::size_t bytes = static_cast<std::size_t>(e - b);
+  unsigned threads = std::min(8u, std::max(1u, std::thread::hardware_concurrency()));
+  if (bytes < (std::size_t(4) << 20))
+    threads = 1;
+  std::vector<const char*> cut(threads + 1, e);
+  cut[0] = b;
+  for (unsigned k = 1; k < threads; ++k)
+  {
+    const char* q = std::max(b + bytes * k / threads, cut[k - 1]);
+    const char* nl = static_cast<const char*>(std::memchr(q, '\n', e - q));
+    cut[k] = nl ? nl + 1 : e;
+  }
+  std::vector<std::uint64_t> rows(threads);
+  std::vector<std::size_t> newlines(threads);
+  auto run = [threads](const auto& work) {
+    if (threads == 1)
+      return work(0u);
+    std::vector<std::thread> pool;
+    for (unsigned k = 0; k < threads; ++k)
+      pool.emplace_back(work, k);
+    for (auto& t : pool)
+      t.join();
+  };
+  run([&](unsigned k) { CountRows(cut[k], cut[k + 1], rows[k], newlines[k]); });
+  std::uint64_t total = 1;
+  for (unsigned k = 0; k < threads; ++k)
+    total += rows[k];
+  // Each row of `columns` numbers takes at least 2 * columns - 1 characters: a count beyond that means
+  // short rows, an error found without allocating for them.
+  if ((total - 1) > bytes / (2 * columns - 1) + 1)
+  {
+    std::vector<double> row(columns);
+    if (!ParseRows(b, e, columns, row.data(), false, line, error))
+      return false;
+    error = "line " + std::to_string(line) + ": rows too short for " + std::to_string(columns) + " columns";
+    return false;
+  }
+  try
+  {
+    table.Values.resize(total * columns);
+  }
+  catch (const std::bad_alloc&)
+  {
+    error = "out of memory for " + std::to_string(total) + " rows of " + std::to_string(columns) + " columns";
+    return false;
+  }
+  std::vector<std::string> errors(threads);
+  std::vector<char> ok(threads, 1);
+  std::vector<std::uint64_t> firstRow(threads, 1);
+  std::vector<std::size_t> firstLine(threads, line);
+  for (unsigned k = 1; k < threads; ++k)
+  {
+    firstRow[k] = firstRow[k - 1] + rows[k - 1];
+    firstLine[k] = firstLine[k - 1] + newlines[k - 1];
+  }
+  double* values = table.Values.data();
+  run([&](unsigned k) {
+    ok[k] = ParseRows(cut[k], cut[k + 1], columns, values + firstRow[k] * columns, true, firstLine[k], errors[k]);
+  });
+  for (unsigned k = 0; k < threads; ++k)
+    if (!ok[k])
+    {
+      error = errors[k];
+      return false;
+    }
+  table.Rows = total;
   return true;
 }
 
@@ -168,8 +339,6 @@ bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std
           std::to_string(table.Names.size()));
       columns = fields.size();
       inData = true;
-      if (!sniff && table.DeclaredCount > 0)
-        table.Values.reserve(std::min<std::uint64_t>(table.DeclaredCount, size / 6) * columns);
       for (const auto& f : fields)
       {
         double v;
@@ -177,6 +346,16 @@ bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std
         table.Values.push_back(v);
       }
       ++table.Rows;
+      if (!sniff)
+      {
+        // The rest is data: in bulk.
+        if (!ParseData(p, end, columns, line, table, error))
+        {
+          table = Table();
+          return false;
+        }
+        break;
+      }
       continue;
     }
     if (!table.Names.empty())

@@ -4,9 +4,13 @@
 #ifndef meshfree_XYZFormat_h
 #define meshfree_XYZFormat_h
 
+#include "PCDFormat.h" // AllocateBulk
+
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace meshfree
@@ -14,17 +18,50 @@ namespace meshfree
 namespace xyz
 {
 
+/// A std::vector allocator over pcd::AllocateBulk that leaves new elements uninitialised: the parser
+/// writes every value, so resize() neither zero-fills nor takes a page fault per 4 KB.
+template <class T>
+struct BulkAllocator
+{
+  using value_type = T;
+  BulkAllocator() = default;
+  template <class U>
+  BulkAllocator(const BulkAllocator<U>&)
+  {
+  }
+  T* allocate(std::size_t n)
+  {
+    void* p = pcd::AllocateBulk(n * sizeof(T));
+    if (!p)
+      throw std::bad_alloc();
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t) { std::free(p); }
+  template <class U, class... A>
+  void construct(U* p, A&&... args)
+  {
+    if constexpr (sizeof...(A) == 0)
+      ::new (static_cast<void*>(p)) U;
+    else
+      ::new (static_cast<void*>(p)) U(std::forward<A>(args)...);
+  }
+  bool operator==(const BulkAllocator&) const { return true; }
+  bool operator!=(const BulkAllocator&) const { return false; }
+};
+
 struct Table
 {
   std::vector<std::string> Names; // one per column: from the header line, or "Column<k>" (1-based)
   bool NamedByHeader = false;
   std::uint64_t Rows = 0;
-  std::vector<double> Values;     // Rows x Names.size(), row-major
+  std::vector<double, BulkAllocator<double>> Values; // Rows x Names.size(), row-major
   int Coordinate[3] = { 0, 1, 2 }; // the columns holding x, y and z
   std::int64_t DeclaredCount = -1; // Leica's first line, -1 when absent
 };
 
 /// Parses the whole text. On failure returns false, leaves the table empty and says why (with the line).
+/// The header lines are read one by one; the data rows are counted, allocated once and parsed in place,
+/// in pieces on several threads for large files.
 bool Parse(const char* data, std::size_t size, Table& table, std::string& error);
 
 /// True when the start of data reads as a text point cloud (consistent rows of >= 3 numbers). Used to

@@ -184,10 +184,16 @@ int vtkMeshFreePCDReader::RequestData(
     if (IsPackedColor(f))
     {
       const int comps = f.Name == "rgba" ? 4 : 3;
+      auto* dst = static_cast<unsigned char*>(pcd::AllocateBulk(static_cast<std::size_t>(n) * comps));
+      if (!dst)
+      {
+        vtkErrorMacro("Cannot read '" << this->FileName << "': out of memory for " << n << " colours.");
+        output->Initialize();
+        return 1;
+      }
       auto colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
       colors->SetNumberOfComponents(comps);
-      colors->SetNumberOfTuples(n);
-      unsigned char* dst = colors->GetPointer(0);
+      colors->SetArray(dst, static_cast<vtkIdType>(n) * comps, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
       const unsigned char* src = cloud.Columns[c].Data();
       for (vtkIdType i = 0; i < n; ++i)
       {
@@ -234,7 +240,11 @@ int vtkMeshFreePCDReader::RequestData(
   dims->SetValue(1, static_cast<vtkIdType>(fileHeight));
   output->GetFieldData()->AddArray(dims);
 
-  meshfree::AddVertexCells(output, n);
+  if (!meshfree::AddVertexCells(output, n))
+  {
+    vtkErrorMacro("Cannot read '" << this->FileName << "': out of memory for " << n << " vertex cells.");
+    output->Initialize();
+  }
   return 1;
 }
 

@@ -17,6 +17,7 @@
 #include <cctype>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 vtkStandardNewMacro(vtkMeshFreeXYZReader);
 
@@ -83,29 +84,55 @@ int vtkMeshFreeXYZReader::RequestData(
       names[cols - 3] = "r", names[cols - 2] = "g", names[cols - 1] = "b";
   }
 
-  // Rows to keep.
+  // Rows to keep (all, unless some have a non-finite coordinate).
   const int* xyz = table.Coordinate;
-  std::vector<vtkIdType> rows;
-  rows.reserve(table.Rows);
-  for (std::uint64_t r = 0; r < table.Rows; ++r)
+  const double* values = table.Values.data();
+  auto finiteRow = [&](std::uint64_t r) {
+    const double* v = values + r * cols;
+    return std::isfinite(v[xyz[0]]) && std::isfinite(v[xyz[1]]) && std::isfinite(v[xyz[2]]);
+  };
+  std::vector<vtkIdType> rows; // the kept rows, when some were dropped
+  bool dropped = false;
+  if (!this->KeepInvalidPoints)
   {
-    const double* v = &table.Values[r * cols];
-    if (this->KeepInvalidPoints ||
-      (std::isfinite(v[xyz[0]]) && std::isfinite(v[xyz[1]]) && std::isfinite(v[xyz[2]])))
-      rows.push_back(static_cast<vtkIdType>(r));
+    std::uint64_t firstBad = 0;
+    while (firstBad < table.Rows && finiteRow(firstBad))
+      ++firstBad;
+    if (firstBad < table.Rows)
+    {
+      dropped = true;
+      rows.reserve(table.Rows);
+      for (std::uint64_t r = 0; r < table.Rows; ++r)
+        if (r < firstBad || (r > firstBad && finiteRow(r)))
+          rows.push_back(static_cast<vtkIdType>(r));
+      vtkWarningMacro("'" << this->FileName << "': dropped " << table.Rows - rows.size() << " of " << table.Rows
+                          << " points whose x, y or z is not a finite number; switch KeepInvalidPoints on to keep them.");
+    }
   }
-  if (rows.size() != table.Rows)
-    vtkWarningMacro("'" << this->FileName << "': dropped " << table.Rows - rows.size() << " of " << table.Rows
-                        << " points whose x, y or z is not a finite number; switch KeepInvalidPoints on to keep them.");
-  const vtkIdType n = static_cast<vtkIdType>(rows.size());
+  const vtkIdType n = dropped ? static_cast<vtkIdType>(rows.size()) : static_cast<vtkIdType>(table.Rows);
+  auto row = [&](vtkIdType i) { return values + (dropped ? rows[i] : i) * cols; };
 
+  // Every output array in fresh bulk memory that the VTK array adopts (no zero-fill, no per-page faults).
+  bool outOfMemory = false;
+  auto bulk = [&](auto* array, int components) {
+    using T = typename std::remove_pointer<decltype(array->GetPointer(0))>::type;
+    auto* p = static_cast<T*>(meshfree::pcd::AllocateBulk(sizeof(T) * std::max<vtkIdType>(1, n * components)));
+    outOfMemory = outOfMemory || !p;
+    array->SetNumberOfComponents(components);
+    if (p)
+      array->SetArray(p, n * components, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+    return p;
+  };
+
+  vtkNew<vtkDoubleArray> coordinates;
+  if (double* p = bulk(coordinates.Get(), 3))
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      const double* v = row(i);
+      p[3 * i] = v[xyz[0]], p[3 * i + 1] = v[xyz[1]], p[3 * i + 2] = v[xyz[2]];
+    }
   vtkNew<vtkPoints> points;
-  points->SetDataType(VTK_DOUBLE);
-  points->SetNumberOfPoints(n);
-  double* p = static_cast<double*>(points->GetVoidPointer(0));
-  for (vtkIdType i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k)
-      p[3 * i + k] = table.Values[rows[i] * cols + xyz[k]];
+  points->SetData(coordinates);
   output->SetPoints(points);
 
   // Colour columns r g b (or red green blue) of integers 0..255 become one unsigned-char array.
@@ -121,18 +148,17 @@ int vtkMeshFreeXYZReader::RequestData(
   for (vtkIdType i = 0; colors && i < n; ++i)
     for (int k = 0; k < 3; ++k)
     {
-      const double v = table.Values[rows[i] * cols + rgb[k]];
+      const double v = row(i)[rgb[k]];
       colors = colors && v >= 0 && v <= 255 && v == std::floor(v);
     }
   if (colors)
   {
     vtkNew<vtkUnsignedCharArray> array;
     array->SetName("RGB");
-    array->SetNumberOfComponents(3);
-    array->SetNumberOfTuples(n);
-    for (vtkIdType i = 0; i < n; ++i)
-      for (int k = 0; k < 3; ++k)
-        array->SetTypedComponent(i, k, static_cast<unsigned char>(table.Values[rows[i] * cols + rgb[k]]));
+    if (unsigned char* p = bulk(array.Get(), 3))
+      for (vtkIdType i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k)
+          p[3 * i + k] = static_cast<unsigned char>(row(i)[rgb[k]]);
     output->GetPointData()->AddArray(array);
   }
 
@@ -145,12 +171,16 @@ int vtkMeshFreeXYZReader::RequestData(
       continue;
     vtkNew<vtkDoubleArray> array;
     array->SetName(names[c].c_str());
-    array->SetNumberOfValues(n);
-    for (vtkIdType i = 0; i < n; ++i)
-      array->SetValue(i, table.Values[rows[i] * cols + c]);
+    if (double* p = bulk(array.Get(), 1))
+      for (vtkIdType i = 0; i < n; ++i)
+        p[i] = row(i)[c];
     output->GetPointData()->AddArray(array);
   }
-  meshfree::AddVertexCells(output, n);
+  if (outOfMemory || !meshfree::AddVertexCells(output, n))
+  {
+    vtkErrorMacro("Cannot read '" << this->FileName << "': out of memory for " << n << " points.");
+    output->Initialize();
+  }
   return 1;
 }
 

@@ -264,3 +264,37 @@ TEST(ReadersVTK, XYZReaderHeaderNamesArrays)
   ASSERT_NE(out->GetPointData()->GetArray("g"), nullptr);
   EXPECT_EQ(out->GetPointData()->GetArray("g")->GetComponent(0, 0), 0.1);
 }
+
+TEST(ReadersVTK, XYZReaderDropsOrKeepsInvalidRowsWithAlignedArrays)
+{
+  const std::string path = OutFile("invalid_rows.xyz");
+  WriteText(path, "x y z v\n0 0 0 10\n1 nan 0 11\n2 0 0 12\ninf 0 0 13\n4 0 0 14\n");
+  for (bool keep : { false, true })
+  {
+    SCOPED_TRACE(keep);
+    vtkNew<MessageCatcher> msg;
+    auto out = Read<vtkMeshFreeXYZReader>(path, msg, keep);
+    EXPECT_TRUE(msg->Errors.empty()) << msg->Errors;
+    EXPECT_EQ(msg->Warnings.find("dropped 2 of 5") != std::string::npos, !keep) << msg->Warnings;
+    const vtkIdType n = keep ? 5 : 3;
+    ASSERT_EQ(out->GetNumberOfPoints(), n);
+    ASSERT_EQ(out->GetNumberOfVerts(), n);
+    auto* v = out->GetPointData()->GetArray("v");
+    ASSERT_NE(v, nullptr);
+    ASSERT_EQ(v->GetNumberOfTuples(), n);
+    const double kept[] = { 10, 12, 14 };
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      // The value column stays with its point: v = 10 + x wherever x is finite.
+      EXPECT_EQ(v->GetComponent(i, 0), keep ? 10.0 + i : kept[i]);
+      if (std::isfinite(out->GetPoint(i)[0]))
+        EXPECT_EQ(v->GetComponent(i, 0), 10.0 + out->GetPoint(i)[0]);
+    }
+  }
+  WriteText(path, "nan 0 0\n0 nan 0\n");
+  vtkNew<MessageCatcher> msg;
+  auto out = Read<vtkMeshFreeXYZReader>(path, msg);
+  EXPECT_NE(msg->Warnings.find("dropped 2 of 2"), std::string::npos) << msg->Warnings;
+  EXPECT_EQ(out->GetNumberOfPoints(), 0);
+  EXPECT_EQ(out->GetNumberOfVerts(), 0);
+}

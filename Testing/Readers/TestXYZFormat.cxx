@@ -124,3 +124,56 @@ TEST(XYZFormat, SniffingTellsCloudsFromOtherXYZFormats)
     big += "123.456 789.012 345.678 1\n";
   EXPECT_TRUE(LooksLikeCloud(big.data(), big.size()));
 }
+
+// Large files: the data rows are counted and parsed in pieces (several threads above 4 MB); the values, the
+// row count and the line numbers of errors must be those of a line-by-line reading.
+TEST(XYZFormat, LargeFileParsedInPiecesMatchesLineByLine)
+{
+  std::string text = "# scan\nx y z intensity\n";
+  const int rows = 300000;
+  for (int i = 0; i < rows; ++i)
+  {
+    text += std::to_string(i) + " " + std::to_string(i % 97) + ".25 -" + std::to_string(i % 13) + " " +
+      std::to_string(i * 0.5) + (i % 5 == 0 ? "\r\n" : "\n");
+    if (i % 1000 == 999)
+      text += "# a comment inside the data\n\n";
+  }
+  ASSERT_GT(text.size(), std::size_t(5) << 20);
+  Table t = MustParse(text);
+  ASSERT_EQ(t.Rows, static_cast<std::uint64_t>(rows));
+  ASSERT_EQ(t.Values.size(), 4u * rows);
+  for (int i : { 0, 1, 999, 1000, 123457, rows - 1 })
+  {
+    EXPECT_EQ(t.Values[4 * i], double(i)) << i;
+    EXPECT_EQ(t.Values[4 * i + 1], (i % 97) + 0.25) << i;
+    EXPECT_EQ(t.Values[4 * i + 2], -double(i % 13)) << i;
+    EXPECT_EQ(t.Values[4 * i + 3], i * 0.5) << i;
+  }
+  // An error deep in the file names its line: data row r is on line 2 + r + 1 + 2 * (r / 1000).
+  const int bad = 250123;
+  const std::size_t line = 2 + bad + 1 + 2 * (bad / 1000);
+  std::size_t at = 0;
+  for (std::size_t l = 1; l < line; ++l)
+    at = text.find('\n', at) + 1;
+  std::string broken = text;
+  broken.insert(broken.find('\n', at), " 7");
+  EXPECT_NE(MustFail(broken).find("line " + std::to_string(line) + ": 5 columns where the cloud has 4"),
+    std::string::npos)
+    << MustFail(broken);
+  broken = text;
+  broken.replace(at, 1, "q");
+  EXPECT_NE(MustFail(broken).find("line " + std::to_string(line) + ": 'q"), std::string::npos) << MustFail(broken);
+}
+
+// A wide first row followed by many short lines must fail with the line of the first short row, without
+// allocating rows x columns for them.
+TEST(XYZFormat, ShortRowsAfterAWideRowFailWithoutAllocating)
+{
+  std::string text;
+  for (int c = 0; c < 5000; ++c)
+    text += "1 ";
+  text += "\n";
+  for (int i = 0; i < 200000; ++i)
+    text += "1\n";
+  EXPECT_NE(MustFail(text).find("line 2: 1 columns where the cloud has 5000"), std::string::npos) << MustFail(text);
+}
