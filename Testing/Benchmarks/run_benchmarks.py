@@ -2,9 +2,12 @@
 
     MESHFREE_PLUGIN=<build>/lib/paraview-5.11/plugins/MeshFree/MeshFree.so \\
       pvpython --no-mpi Testing/Benchmarks/run_benchmarks.py [--quick | --smoke] [--out DIR] [--only PARTS]
+      [--threads N] [--rbf-global-limit N]
 
 The plugin comes from $MESHFREE_PLUGIN, else from <source>/build. --out defaults to
 <build>/benchmark-results. --only takes a comma list of approximation,sph,solid (default: all three).
+--threads N puts every tool on N threads (default: all cores; on a machine shared with other work, --threads 1
+gives a fair comparison, since OpenMP and thread pools wait for descheduled threads at every barrier).
 Writes approximation.csv, sph.csv, solid.csv, pareto.md and the PNGs (bench_report.py draws them).
 
 approximation.csv  method,peer,n,degree,rms_error,max_error,seconds,evals_per_second
@@ -68,6 +71,15 @@ import time
 
 os.environ.setdefault("VTK_SMP_BACKEND_IN_USE", "STDThread")
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+# --threads N: every tool on N threads (OpenMP in MeshFree's core, VTK's SMP pool, BLAS under SciPy). Set before
+# numpy, VTK or the plugin load their thread pools.
+THREADS = None
+for _i, _a in enumerate(sys.argv):
+    if _a.startswith("--threads"):
+        THREADS = int(_a.split("=", 1)[1] if "=" in _a else sys.argv[_i + 1])
+if THREADS:
+    for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ[_v] = str(THREADS)
 
 import numpy as np  # noqa: E402
 
@@ -406,8 +418,11 @@ def run_approximation(cfg):
     from vtkmodules.vtkCommonCore import vtkSMPTools
 
     vtkSMPTools.SetBackend("STDThread")
+    if THREADS:
+        vtkSMPTools.Initialize(THREADS)
     log("VTK SMP backend: %s, %d threads" % (vtkSMPTools.GetBackend(), vtkSMPTools.GetEstimatedNumberOfThreads()))
-    proxy = simple.MeshlessApproximation(Input=simple.Sphere())
+    sphere = simple.Sphere()  # a placeholder input: the VTK object is fed directly below
+    proxy = simple.MeshlessApproximation(Input=sphere)
     proxy.WeightFunction = "Wendland"
     proxy.NeighborCount = 20
     filt = proxy.GetClientSideObject()  # the VTK object, fed directly: no client-server traffic in the timing
@@ -456,6 +471,7 @@ def run_approximation(cfg):
             log("  %-32s d%d  %s rms %.3g  max %.3g  %.4f s  %.3g evals/s" % (
                 m.name, m.degree, first, r["rms_error"], r["max_error"], seconds, r["evals_per_second"]))
     simple.Delete(proxy)
+    simple.Delete(sphere)
     return rows
 
 
@@ -698,7 +714,7 @@ def solid_cantilever(resolution, integrator, end, implicit_dt):
     from paraview import simple
     H, L = BEAM_H, BEAM_L
     spacing = H / resolution
-    src = simple.MLSDeformableSolid(Shape="Box", ShapeBounds=[-H, L, 0, H, 0, H], PhyxelSpacing=spacing,
+    src = simple.MLSDeformableSolid(Input=None, Shape="Box", ShapeBounds=[-H, L, 0, H, 0, H], PhyxelSpacing=spacing,
                                     YoungModulus=BEAM_E, PoissonRatio=0.0, Density=BEAM_RHO, VolumeStiffness=0.0,
                                     HourglassStiffness=0.05, Gravity=[0, 0, -BEAM_G], Damping=0.8,
                                     Container="None", SelfContact=0, FixedBounds=[-1, 0, -1, 1, -1, 1],
@@ -734,14 +750,14 @@ def solid_throughput(edge, integrator, steps_wanted):
     from paraview import simple
     a = 0.01
     bounds = [-edge * a / 2, edge * a / 2, -edge * a / 2, edge * a / 2, 0.05, 0.05 + edge * a]
-    probe = simple.MLSDeformableSolid(Shape="Box", ShapeBounds=bounds, PhyxelSpacing=a, VolumeStiffness=1e4,
+    probe = simple.MLSDeformableSolid(Input=None, Shape="Box", ShapeBounds=bounds, PhyxelSpacing=a, VolumeStiffness=1e4,
                                       EndTime=1e-3, OutputInterval=1e-3)
     probe.UpdatePipeline(0.0)
     stable = info_double(probe, "StableTimeStep")
     simple.Delete(probe)
     dt = stable * (10 if integrator == "Implicit" else 1)
     span = dt * steps_wanted
-    src = simple.MLSDeformableSolid(Shape="Box", ShapeBounds=bounds, PhyxelSpacing=a, VolumeStiffness=1e4,
+    src = simple.MLSDeformableSolid(Input=None, Shape="Box", ShapeBounds=bounds, PhyxelSpacing=a, VolumeStiffness=1e4,
                                     Integrator=integrator, TimeStep=dt, InitialVelocity=[0, 0, -1],
                                     EndTime=2 * span, OutputInterval=span)
     src.UpdatePipeline(span)  # warm-up
@@ -809,6 +825,8 @@ def main():
     parser.add_argument("--only", default="approximation,sph,solid", help="comma list of parts to run")
     parser.add_argument("--rbf-global-limit", type=int,
                         help="largest N for SciPy's global RBF (default 10,000; 1,000 with --quick)")
+    parser.add_argument("--threads", type=int, help="threads for every tool (OpenMP, VTK SMP, BLAS); default: "
+                        "all cores. 1 gives a fair same-threads comparison on a loaded machine")
     parser.add_argument("--no-plots", action="store_true")
     args = parser.parse_args()
     cfg = Config("smoke" if args.smoke else "quick" if args.quick else "full")
@@ -822,6 +840,7 @@ def main():
     from paraview import simple
     simple.LoadPlugin(plugin, remote=False)  # its proxies appear in paraview.simple
     machine = machine_description()
+    machine += ", %s thread(s) per tool" % (THREADS or os.cpu_count())
     log("MeshFree benchmarks (%s) -> %s\nplugin %s\nmachine: %s, load average %s" % (
         "smoke" if cfg.smoke else "quick" if args.quick else "full", out, plugin, machine,
         " ".join("%.2f" % v for v in os.getloadavg())))
