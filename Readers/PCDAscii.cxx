@@ -233,21 +233,22 @@ bool ParseRange(const AsciiLayout& L, const char*& p, const char* end, std::uint
   return true;
 }
 
-// Lines holding something other than blanks, and newlines, in [b, e).
+// Lines holding something other than blanks, and newlines, in [b, e). Line ends are found with memchr
+// (vectorised) and only the start of each line is looked at: a byte-by-byte pass here used to cost a third
+// of the whole ascii decoding.
 void CountLines(const char* b, const char* e, std::uint64_t& points, std::size_t& newlines)
 {
   points = 0, newlines = 0;
-  bool content = false;
-  for (; b < e; ++b)
+  while (b < e)
   {
-    if (*b == '\n')
-    {
-      points += content, ++newlines, content = false;
-    }
-    else if (!IsSpace(*b))
-      content = true;
+    const char* nl = static_cast<const char*>(std::memchr(b, '\n', e - b));
+    const char* le = nl ? nl : e;
+    while (b < le && IsSpace(*b))
+      ++b;
+    points += (b < le);
+    newlines += (nl != nullptr);
+    b = nl ? nl + 1 : e;
   }
-  points += content;
 }
 } // namespace
 
