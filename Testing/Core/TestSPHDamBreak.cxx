@@ -13,9 +13,10 @@
 //    The 10 % gate is asserted there.
 //  * 0.84 <= T <= 2.20: the front leads by 11.5-19 %. The 10 % gate is NOT met there. The lead does not
 //    come from the front definition (max x gives the same), the resolution (a/dx = 80 leads as much), the kernel
-//    (poly6, h = 2.6 or 3 dx), the stiffness (c0 = 20 sqrt(g H)), the artificial viscosity (0 to 0.1) or the
-//    initial state (hydrostatically compressed, no pressure blast): it is a delay of the experiment's time
-//    origin. The same SPH curve compared with the experiment at T + 0.25 (about 13 ms at M&M's a = 57 mm, the
+//    (poly6, h = 2.6 or 3 dx), the stiffness (c0 = 20 sqrt(g H)), the artificial viscosity (0 to 0.1), wall
+//    friction (the artificial viscosity also applied against the wall dummies, as DualSPHysics does: still
+//    13-19 % ahead at T = 1.19 for alpha = 0.02-0.1) or the initial state (hydrostatically compressed, no
+//    pressure blast): it is a delay of the experiment's time origin. The same SPH curve compared with the experiment at T + 0.25 (about 13 ms at M&M's a = 57 mm, the
 //    order of a gate's opening time; the gate is known to slow the early front of M&M and of Koshizuka & Oka)
 //    agrees within 2.6 % at every tabulated T. The test asserts that diagnosis (5 %) and guards the early lead
 //    at its measured level (<= 20 %) so that a regression shows, but the early points do not pass the issue's
