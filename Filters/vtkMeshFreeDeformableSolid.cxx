@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -127,9 +128,29 @@ bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
     vtkErrorMacro("PhyxelSpacing must be a positive number, not " << this->PhyxelSpacing << ".");
     return false;
   }
-  if (!(this->OutputInterval > 0.0) || !(this->EndTime >= 0.0))
+  if (!(this->OutputInterval > 0.0) || !(this->EndTime >= 0.0) || !std::isfinite(this->OutputInterval) ||
+    !std::isfinite(this->EndTime))
   {
-    vtkErrorMacro("OutputInterval must be positive and EndTime non-negative.");
+    vtkErrorMacro("OutputInterval must be positive and EndTime non-negative, both finite (got "
+      << this->OutputInterval << ", " << this->EndTime << ").");
+    return false;
+  }
+  // Finite and not inverted; flat boxes are allowed when `flat` is (a zero-thickness Box shape gives a
+  // coplanar plate of phyxels).
+  const auto validBox = [](const double* b, bool flat) {
+    for (int a = 0; a < 3; ++a)
+    {
+      if (!std::isfinite(b[2 * a]) || !std::isfinite(b[2 * a + 1]) ||
+        !(flat ? b[2 * a] <= b[2 * a + 1] : b[2 * a] < b[2 * a + 1]))
+      {
+        return false;
+      }
+    }
+    return true;
+  };
+  if (this->Container != NO_CONTAINER && !validBox(this->ContainerBounds, false))
+  {
+    vtkErrorMacro("ContainerBounds must be finite with x0 < x1, y0 < y1, z0 < z1 when Container is not None.");
     return false;
   }
 
@@ -138,13 +159,27 @@ bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
   double volume = 0.0;
   vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
   const auto tooMany = static_cast<meshfree::Index>(5e7);
-  if (input && input->GetNumberOfPoints() > 0)
+  if (input && input->GetNumberOfPoints() == 0)
+  {
+    vtkErrorMacro("The input surface is empty: connect a closed surface, or no input to use Shape.");
+    return false;
+  }
+  if (input)
   {
     vtkCellArray* polys = input->GetPolys();
     impl.SurfacePoints.resize(3 * input->GetNumberOfPoints());
+    vtkIdType nonFinite = 0;
     for (vtkIdType p = 0; p < input->GetNumberOfPoints(); ++p)
     {
       input->GetPoint(p, &impl.SurfacePoints[3 * p]);
+      const double* x = &impl.SurfacePoints[3 * p];
+      nonFinite += (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2])) ? 0 : 1;
+    }
+    if (nonFinite > 0)
+    {
+      vtkErrorMacro("The input surface has " << nonFinite << " points with NaN/Inf coordinates.");
+      impl.SurfacePoints.clear();
+      return false;
     }
     const vtkIdType* ids = nullptr;
     vtkIdType count = 0;
@@ -154,6 +189,38 @@ bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
       {
         impl.Triangles.insert(impl.Triangles.end(), { ids[0], ids[t], ids[t + 1] });
       }
+    }
+    // Closed: every edge is shared by exactly two triangles (in opposite directions for a consistent
+    // orientation; the count alone catches holes and open sheets).
+    std::vector<std::pair<vtkIdType, vtkIdType>> edges;
+    edges.reserve(impl.Triangles.size());
+    for (size_t t = 0; t + 2 < impl.Triangles.size(); t += 3)
+    {
+      for (int e = 0; e < 3; ++e)
+      {
+        const vtkIdType a = impl.Triangles[t + e], b = impl.Triangles[t + (e + 1) % 3];
+        edges.emplace_back(std::min(a, b), std::max(a, b));
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    size_t boundary = 0;
+    for (size_t e = 0; e < edges.size();)
+    {
+      size_t f = e;
+      while (f < edges.size() && edges[f] == edges[e])
+      {
+        ++f;
+      }
+      boundary += (f - e == 2) ? 0 : 1;
+      e = f;
+    }
+    if (boundary > 0)
+    {
+      vtkErrorMacro("The input must be a closed surface made of polygons: " << boundary
+                                                                            << " edges are not shared by exactly two polygons.");
+      impl.SurfacePoints.clear();
+      impl.Triangles.clear();
+      return false;
     }
     volume = std::fabs(meshfree::MeshVolume(impl.SurfacePoints, impl.Triangles));
     if (impl.Triangles.empty() || !(volume > 0.0))
@@ -185,6 +252,11 @@ bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
   {
     const auto shape = static_cast<meshfree::ElasticShape>(this->Shape);
     const double* b = this->ShapeBounds;
+    if (!validBox(b, true))
+    {
+      vtkErrorMacro("ShapeBounds must be finite with x0 <= x1, y0 <= y1, z0 <= z1.");
+      return false;
+    }
     if (!meshfree::SampleLattice(b, this->PhyxelSpacing,
           [shape, b](const double* p) { return meshfree::InsideShape(shape, b, p); }, rest, tooMany))
     {
@@ -257,7 +329,12 @@ bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
   }
   this->NumberOfPhyxels = static_cast<int>(impl.Solid.Size());
   this->StableTimeStep = impl.Solid.StableTimeStep();
-  if (this->Integrator == SYMPLECTIC_EULER && this->TimeStep > this->StableTimeStep)
+  if (!(this->TimeStep >= 0.0) || !std::isfinite(this->TimeStep))
+  {
+    vtkWarningMacro("TimeStep " << this->TimeStep
+                                << " is not a non-negative finite number: the automatic step is used (as for 0).");
+  }
+  else if (this->Integrator == SYMPLECTIC_EULER && this->TimeStep > this->StableTimeStep)
   {
     vtkWarningMacro("TimeStep " << this->TimeStep << " s exceeds the stable symplectic Euler step "
                                 << this->StableTimeStep
@@ -320,7 +397,7 @@ int vtkMeshFreeDeformableSolid::RequestData(
   }
   impl.Solid.State() = *start;
   const bool implicit = this->Integrator == IMPLICIT;
-  double maxStep = this->TimeStep > 0.0 ? this->TimeStep : 0.0;
+  double maxStep = this->TimeStep > 0.0 && std::isfinite(this->TimeStep) ? this->TimeStep : 0.0;
   if (implicit && !(maxStep > 0.0))
   {
     maxStep = 20.0 * impl.Solid.StableTimeStep();

@@ -33,13 +33,26 @@ bool ElasticSolid::Initialize(
               "(lambda = E nu / ((1 + nu)(1 - 2 nu))) is undefined.";
     return false;
   }
-  if (!(s.Density > 0.0) || !std::isfinite(s.Density) || !(s.VolumeStiffness >= 0.0) ||
-    !std::isfinite(s.VolumeStiffness) || !(s.SupportScale > 0.0) || !(s.HourglassStiffness >= 0.0) ||
-    !(s.Damping >= 0.0) || !(s.StableStepFactor > 0.0))
+  // Each setting by its property name: positive (or non-negative) and finite.
+  const struct
   {
-    message = "Density, SupportScale and StableStepFactor must be positive; VolumeStiffness, hourglass "
-              "stiffness and Damping non-negative.";
-    return false;
+    const char* Name;
+    double Value;
+    bool ZeroAllowed;
+  } checks[] = { { "Density", s.Density, false }, { "SupportScale", s.SupportScale, false },
+    { "StableStepFactor", s.StableStepFactor, false }, { "VolumeStiffness", s.VolumeStiffness, true },
+    { "HourglassStiffness", s.HourglassStiffness, true }, { "Damping", s.Damping, true },
+    { "PlasticYield", s.PlasticYield, true }, { "PlasticCreep", s.PlasticCreep, true },
+    { "PlasticMaxStrain", s.PlasticMaxStrain, true } };
+  for (const auto& c : checks)
+  {
+    if (!std::isfinite(c.Value) || !(c.ZeroAllowed ? c.Value >= 0.0 : c.Value > 0.0))
+    {
+      msg << c.Name << " must be a finite " << (c.ZeroAllowed ? "non-negative" : "positive") << " number, not "
+          << c.Value << ".";
+      message = msg.str();
+      return false;
+    }
   }
   const Index n = static_cast<Index>(rest.size() / 3);
   for (double c : rest)

@@ -99,7 +99,11 @@ struct Suite
     static const bool verbose = std::getenv("MESHFREE_STRESS_VERBOSE") != nullptr;
     if (verbose)
     {
-      std::cout << "case: " << name << std::endl;
+      const auto now = std::chrono::steady_clock::now();
+      static auto last = now;
+      std::cout << "  (" << std::chrono::duration<double>(now - last).count() << " s)\ncase: " << name
+                << std::endl;
+      last = now;
     }
   }
   bool Check(bool ok, const std::string& what)
