@@ -1,5 +1,9 @@
 """Benchmark of the Meshless Approximation filter (issue #3). Not a test: it measures.
 
+The full comparison (every method and degree, VTK's and SciPy's interpolators, Renka-Brown's ten functions and a
+3D field, Pareto tables and plots) is run_benchmarks.py (issue #7); this script keeps the figure quoted in the
+README's "Measured" table.
+
 Run:  VTK_SMP_BACKEND_IN_USE=STDThread MESHFREE_PLUGIN=<build>/lib/paraview-5.11/plugins/MeshFree/MeshFree.so \
       pvpython --no-mpi Testing/Benchmarks/bench_approximation.py [--quick]
 
