@@ -53,12 +53,12 @@ case "${1:-}" in
     mkdir -p "$out"
     echo "== running the demo; pictures go to $out"
     export MESHFREE_PLUGIN="$build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so" OMP_WAIT_POLICY=passive
-    # Kernels and neighbour grid; thesis figures 3.1-3.5 (approximation) and 4.6 (deformable octahedron)
-    # rebuilt from Data/; the deformable scenes of figs 4.6-4.8; a 3D dam break of 65,536 particles.
+    # Kernels and neighbour grid; thesis figures 3.1-3.5 (approximation), 4.6-4.8 (deformable solids) and
+    # 5.8 (SPH dam break) rebuilt from Data/; the deformable scenes; a 3D dam break of 65,536 particles.
     # One X server for all scripts (starting one per script races with other Xvfb users on busy machines).
     xvfb-run -a -n $((100 + RANDOM % 800)) -s "-screen 0 1280x1024x24" bash -euo pipefail -c '
       for script in demo.py figures/fig_3_x_approximation.py figures/fig_3_5_random256.py \
-                    figures/fig_4_x_deformable.py demo_solid.py demo_dambreak.py; do
+                    figures/fig_4_x_deformable.py figures/fig_5_8_sph.py demo_solid.py demo_dambreak.py; do
         echo "-- $script"
         pvpython --no-mpi "$1/Data/Scripts/$script" --out "$2"
       done' demo "$here" "$out"
