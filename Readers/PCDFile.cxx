@@ -173,9 +173,41 @@ std::uint64_t DropInvalidPoints(Cloud& cloud, std::vector<std::uint64_t>* keptIn
   };
   std::vector<std::uint64_t> kept;
   std::uint64_t firstBad = n;
-  for (std::uint64_t i = 0; i < n && firstBad == n; ++i)
-    if (!valid(i))
-      firstBad = i;
+  bool search = true;
+  if (cloud.PointsSize)
+  {
+    // The usual case, interleaved x y z of one floating type: one branch-free pass over the exponent bits
+    // (all ones: NaN or infinite) that the compiler vectorises; the point-by-point search below runs only
+    // when it finds something.
+    bool any = false;
+    if (cloud.PointsSize == 4)
+    {
+      const unsigned char* p = cloud.Points.Data();
+      for (std::uint64_t i = 0; i < 3 * n; ++i)
+      {
+        std::uint32_t bits;
+        std::memcpy(&bits, p + 4 * i, 4);
+        any |= (bits & 0x7f800000u) == 0x7f800000u;
+      }
+    }
+    else
+    {
+      const unsigned char* p = cloud.Points.Data();
+      for (std::uint64_t i = 0; i < 3 * n; ++i)
+      {
+        std::uint64_t bits;
+        std::memcpy(&bits, p + 8 * i, 8);
+        any |= (bits & 0x7ff0000000000000ull) == 0x7ff0000000000000ull;
+      }
+    }
+    search = any;
+  }
+  if (search)
+  {
+    for (std::uint64_t i = 0; i < n && firstBad == n; ++i)
+      if (!valid(i))
+        firstBad = i;
+  }
   if (firstBad < n)
   {
     kept.reserve(n);
