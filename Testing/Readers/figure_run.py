@@ -11,13 +11,13 @@ FIGURES = os.path.join(source, "Data", "Scripts", "figures")
 PVPYTHON = shutil.which("pvpython") or sys.executable
 
 
-def run(name, script, args, expected):
+def run(name, script, args, expected, folder=FIGURES):
     out = os.path.join(os.environ["MESHFREE_TEST_OUTPUT"], "figures_" + name)
     shutil.rmtree(out, ignore_errors=True)
-    cmd = [PVPYTHON, "--no-mpi", os.path.join(FIGURES, script)] + args + ["--out", out]
+    cmd = [PVPYTHON, "--no-mpi", os.path.join(folder, script)] + args + ["--out", out]
     env = dict(os.environ, OMP_WAIT_POLICY="passive")
     for attempt in range(3):
-        result = subprocess.run(cmd, capture_output=True, text=True, cwd=FIGURES, env=env)
+        result = subprocess.run(cmd, capture_output=True, text=True, cwd=folder, env=env)
         log = result.stdout + result.stderr
         # On this shared machine another job's Xvfb can race ours for the display: that failure (no
         # window at all) is retried; every other failure counts.
