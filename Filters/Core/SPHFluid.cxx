@@ -448,7 +448,7 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
     double dt;
     if (p.CFLNumber > 0.0)
     {
-      dt = std::min(p.TimeStep, this->StableTimeStep(state, p.CFLNumber));
+      dt = std::min(p.TimeStep, this->StableTimeStep(state, std::min(p.CFLNumber, StabilityLambda)));
     }
     else
     {

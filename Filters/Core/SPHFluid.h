@@ -55,8 +55,9 @@
 //
 // Time integration: kick-drift-kick leap-frog (velocity Verlet), one force evaluation per step; the viscous
 // force uses the half-step velocity. Step (CFL): dt = lambda min(h / (c + v_max), sqrt(h / a_max), 0.125 h^2/nu),
-// capped by TimeStep; with CFLNumber = 0 the step is TimeStep unless it exceeds the stability limit (lambda = 0.4),
-// in which case it is reduced and the reduction counted (the VTK layer warns). Steps land exactly on the
+// capped by TimeStep (lambda above 0.4 is reduced to 0.4, with a warning); with CFLNumber = 0 the step is
+// TimeStep unless it exceeds the stability limit (lambda = 0.4), in which case it is reduced and the reduction
+// counted (the VTK layer warns). Steps land exactly on the
 // requested times (the last two steps before a target share the remaining time rather than leave a sliver).
 //
 // Storage is structure of arrays: one array per attribute (position and velocity are xyz triplets, the layout

@@ -18,6 +18,7 @@ namespace
 {
 constexpr double Pi = 3.141592653589793238462643383279502884;
 constexpr Index MaximumParticles = 100000000;
+constexpr double StabilityLambda = 0.4; // as in SPHFluid.cxx: the largest stable CFL factor
 
 bool Finite(const double* v, int n)
 {
@@ -122,6 +123,20 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
         fail("DomainBounds must satisfy min < max on every axis of the simulation");
       }
     }
+  }
+  if (p.CFLNumber > StabilityLambda)
+  {
+    std::ostringstream s;
+    s << "CFLNumber " << p.CFLNumber << " is above " << StabilityLambda
+      << ", the stability limit of the leap-frog step: every step is limited to " << StabilityLambda
+      << " x the stable step (and to TimeStep)";
+    this->WarningList.push_back(s.str());
+  }
+  if (p.Kernels == SPHKernelPair::Mueller)
+  {
+    this->WarningList.push_back("KernelPair 'Mueller' (poly6 density, spiky gradient, as in the thesis) does not "
+                                "conserve energy: the fluid gains energy unless the viscosity is large; 'Spiky' "
+                                "is the physically consistent choice");
   }
   if (!(p.BoundarySpacingFactor > 0.0) || p.ReorderInterval < 1 || p.MaximumStepsPerInterval < 1)
   {

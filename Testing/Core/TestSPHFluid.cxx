@@ -302,6 +302,35 @@ TEST(SPHFluid, HostileSettings)
     EXPECT_TRUE(SPHFluid::Statistics(s, fluid.ParticleMass()).Finite);
     EXPECT_TRUE(InsideDomain(s, q));
   }
+  { // a CFL number far above the stability limit: a warning, and the steps of lambda = 0.4 (same states)
+    SPHParameters q = p;
+    q.CFLNumber = 10.0;
+    q.TimeStep = 1.0;
+    SPHFluid fluid;
+    fluid.Setup(q);
+    ASSERT_FALSE(fluid.Warnings().empty());
+    EXPECT_NE(fluid.Warnings().front().find("CFLNumber"), std::string::npos);
+    SPHState s = fluid.InitialState();
+    ASSERT_EQ(fluid.Advance(s, 0.05), SPHFluid::Status::Ok);
+    q.CFLNumber = 0.4;
+    SPHFluid limited;
+    limited.Setup(q);
+    EXPECT_TRUE(limited.Warnings().empty());
+    SPHState t = limited.InitialState();
+    ASSERT_EQ(limited.Advance(t, 0.05), SPHFluid::Status::Ok);
+    EXPECT_EQ(s.Steps, t.Steps);
+    EXPECT_EQ(s.Position, t.Position);
+    EXPECT_TRUE(SPHFluid::Statistics(s, fluid.ParticleMass()).Finite);
+    EXPECT_TRUE(InsideDomain(s, q));
+  }
+  { // the thesis' kernel pair is not energy-conserving: said when chosen
+    SPHParameters q = p;
+    q.Kernels = SPHKernelPair::Mueller;
+    SPHFluid fluid;
+    fluid.Setup(q);
+    ASSERT_EQ(fluid.Warnings().size(), 1u);
+    EXPECT_NE(fluid.Warnings().front().find("energy"), std::string::npos);
+  }
   { // a stiffness that would need millions of steps: a clear failure instead of a hang
     SPHParameters q = p;
     q.GasStiffness = 1e20;
