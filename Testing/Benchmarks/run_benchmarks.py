@@ -867,7 +867,8 @@ def main():
         log("ERROR: " + p)
     if not args.no_plots and "approximation" in parts:
         text = bench_report.report(out, "%s; load average at the start %s, at the end %s" % (
-            machine, load0, " ".join("%.2f" % v for v in os.getloadavg())))
+            machine, load0, " ".join("%.2f" % v for v in os.getloadavg())),
+            "`pvpython --no-mpi Testing/Benchmarks/run_benchmarks.py %s`" % " ".join(sys.argv[1:]))
         log("\n" + text)
     log("total %.0f s, load average %s; results in %s" % (
         time.perf_counter() - start, " ".join("%.2f" % v for v in os.getloadavg()), out))
