@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -18,40 +19,70 @@ namespace meshfree
 namespace pcd
 {
 
+namespace
+{
+// Every bulk block starts Header bytes after its allocation, which records how to give it back.
+struct BulkHeader
+{
+  std::size_t Mapped; // bytes of the anonymous mapping, 0 when malloc'ed
+  std::size_t Padding[7];
+};
+constexpr std::size_t HeaderBytes = sizeof(BulkHeader);
+static_assert(HeaderBytes == 64, "bulk blocks are 64-byte aligned");
+} // namespace
+
 void* AllocateBulk(std::size_t bytes)
 {
   // Fresh memory costs one page fault per 4 KB page on first touch; in a virtual machine each fault also
   // exits to the host, and for a cold read of a binary file those faults, not the copying, were the main
   // cost (measured: 128 MB touched through 4 KB faults took 3-4 s, through 2 MB pages about 0.1 s).
-  // Large blocks are therefore aligned to 2 MB and offered to transparent huge pages, then prefaulted in
-  // one call. Both are advice: on a kernel without them the pages fault in as usual. free() releases.
-  constexpr std::size_t Huge = std::size_t(2) << 20, Large = std::size_t(4) << 20;
+  // Large blocks are therefore their own anonymous mappings (the kernel aligns those to 2 MB), offered to
+  // transparent huge pages and prefaulted in one call. malloc would place them, after the first free, on
+  // its heap in 4 KB pages, that a trim returns and the next read faults in again one by one. Both calls
+  // are advice: on a kernel without them the pages fault in as usual.
+  constexpr std::size_t Large = std::size_t(4) << 20;
+  if (bytes > std::numeric_limits<std::size_t>::max() - (std::size_t(4) << 20))
+    return nullptr;
+  const std::size_t total = bytes + HeaderBytes;
+  BulkHeader* h = nullptr;
   if (bytes < Large)
   {
-    void* p = std::malloc(bytes > 0 ? bytes : 1);
+    h = static_cast<BulkHeader*>(std::aligned_alloc(HeaderBytes, (total + HeaderBytes - 1) / HeaderBytes * HeaderBytes));
+    if (!h)
+      return nullptr;
+    h->Mapped = 0;
 #ifdef MADV_POPULATE_WRITE
     constexpr std::size_t Page = 4096;
-    if (p && bytes >= 16 * Page)
-    {
-      const auto begin = (reinterpret_cast<std::uintptr_t>(p) + Page - 1) & ~(Page - 1);
-      const auto end = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(Page - 1);
-      if (end > begin)
-        madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
-    }
+    const auto begin = (reinterpret_cast<std::uintptr_t>(h) + Page - 1) & ~(Page - 1);
+    const auto end = (reinterpret_cast<std::uintptr_t>(h) + total) & ~(Page - 1);
+    if (bytes >= 16 * Page && end > begin)
+      madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
 #endif
-    return p;
+    return reinterpret_cast<unsigned char*>(h) + HeaderBytes;
   }
-  const std::size_t rounded = (bytes + Huge - 1) / Huge * Huge;
-  void* p = std::aligned_alloc(Huge, rounded);
-  if (!p)
+  void* p = mmap(nullptr, total, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (p == MAP_FAILED)
     return nullptr;
 #ifdef MADV_HUGEPAGE
-  madvise(p, rounded, MADV_HUGEPAGE);
+  madvise(p, total, MADV_HUGEPAGE);
 #endif
 #ifdef MADV_POPULATE_WRITE
-  madvise(p, rounded, MADV_POPULATE_WRITE);
+  madvise(p, total, MADV_POPULATE_WRITE);
 #endif
-  return p;
+  h = static_cast<BulkHeader*>(p);
+  h->Mapped = total;
+  return static_cast<unsigned char*>(p) + HeaderBytes;
+}
+
+void FreeBulk(void* block)
+{
+  if (!block)
+    return;
+  auto* h = reinterpret_cast<BulkHeader*>(static_cast<unsigned char*>(block) - HeaderBytes);
+  if (h->Mapped)
+    munmap(h, h->Mapped);
+  else
+    std::free(h);
 }
 
 bool Buffer::Allocate(std::size_t bytes)

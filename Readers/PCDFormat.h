@@ -58,26 +58,28 @@ struct Header
   int FieldIndex(const std::string& name) const; // -1 when absent
 };
 
-/// Memory for a large output array, released with std::free (so a VTK array can adopt it with
-/// VTK_DATA_ARRAY_FREE): blocks of 4 MB and more are 2 MB-aligned, backed by transparent huge pages where
-/// the kernel offers them, and prefaulted, so that filling fresh memory does not pay one page fault per
-/// 4 KB. Null when out of memory.
+/// Memory for a large output array, released with FreeBulk (a VTK array adopts it with
+/// VTK_DATA_ARRAY_USER_DEFINED and SetArrayFreeFunction(FreeBulk)): blocks of 4 MB and more are anonymous
+/// mappings backed by transparent huge pages where the kernel offers them, and prefaulted, so that filling
+/// fresh memory does not pay one page fault per 4 KB. 64-byte aligned. Null when out of memory.
 void* AllocateBulk(std::size_t bytes);
+/// Gives back a block of AllocateBulk (null: nothing).
+void FreeBulk(void* block);
 
-/// A malloc'ed block, so that a VTK array can adopt it without a copy (VTK_DATA_ARRAY_FREE).
+/// A block of AllocateBulk, so that a VTK array can adopt it without a copy (see AllocateBulk).
 class Buffer
 {
 public:
   bool Allocate(std::size_t bytes); // AllocateBulk; false when out of memory
   unsigned char* Data() const { return this->Ptr.get(); }
   std::size_t Bytes() const { return this->Size; }
-  unsigned char* Release(); // the caller must free() it
+  unsigned char* Release(); // the caller must FreeBulk() it
   void Shrink(std::size_t bytes) { this->Size = bytes; }
 
 private:
   struct Free
   {
-    void operator()(unsigned char* p) const { std::free(p); }
+    void operator()(unsigned char* p) const { FreeBulk(p); }
   };
   std::unique_ptr<unsigned char, Free> Ptr;
   std::size_t Size = 0;

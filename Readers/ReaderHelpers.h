@@ -5,6 +5,7 @@
 #include "PCDFormat.h"
 
 #include "vtkCellArray.h"
+#include "vtkDataArray.h"
 #include "vtkTypeInt32Array.h"
 #include "vtkTypeInt64Array.h"
 #include "vtkNew.h"
@@ -16,6 +17,13 @@
 
 namespace meshfree
 {
+/// Hands a block of pcd::AllocateBulk holding `values` values to a VTK array, which frees it with FreeBulk.
+inline void AdoptBulk(vtkDataArray* array, void* block, vtkIdType values)
+{
+  array->SetVoidArray(block, values, 0, vtkAbstractArray::VTK_DATA_ARRAY_USER_DEFINED);
+  array->SetArrayFreeFunction(&pcd::FreeBulk);
+}
+
 /// One vertex cell per point, built straight into the cell array's offsets/connectivity (32-bit storage
 /// when it fits: half the memory traffic of vtkIdType for the largest array of the output).
 template <class ArrayT>
@@ -27,8 +35,8 @@ bool FillVertexCells(vtkPolyData* output, vtkIdType n)
   T* c = static_cast<T*>(pcd::AllocateBulk(sizeof(T) * static_cast<std::size_t>(n > 0 ? n : 1)));
   if (!o || !c)
   {
-    std::free(o);
-    std::free(c);
+    pcd::FreeBulk(o);
+    pcd::FreeBulk(c);
     return false;
   }
   for (vtkIdType i = 0; i < n; ++i)
@@ -39,8 +47,8 @@ bool FillVertexCells(vtkPolyData* output, vtkIdType n)
   o[n] = static_cast<T>(n);
   vtkNew<ArrayT> offsets;
   vtkNew<ArrayT> connectivity;
-  offsets->SetArray(o, n + 1, 0, ArrayT::VTK_DATA_ARRAY_FREE);
-  connectivity->SetArray(c, n, 0, ArrayT::VTK_DATA_ARRAY_FREE);
+  AdoptBulk(offsets.Get(), o, n + 1);
+  AdoptBulk(connectivity.Get(), c, n);
   vtkNew<vtkCellArray> verts;
   verts->SetData(offsets, connectivity);
   output->SetVerts(verts);

@@ -36,7 +36,7 @@ struct BulkAllocator
       throw std::bad_alloc();
     return static_cast<T*>(p);
   }
-  void deallocate(T* p, std::size_t) { std::free(p); }
+  void deallocate(T* p, std::size_t) { pcd::FreeBulk(p); }
   template <class U, class... A>
   void construct(U* p, A&&... args)
   {

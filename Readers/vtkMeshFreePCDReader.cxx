@@ -149,7 +149,7 @@ int vtkMeshFreePCDReader::RequestData(
     vtkSmartPointer<vtkDataArray> xyz;
     xyz.TakeReference(vtkDataArray::CreateDataArray(cloud.PointsSize == 4 ? VTK_FLOAT : VTK_DOUBLE));
     xyz->SetNumberOfComponents(3);
-    xyz->SetVoidArray(cloud.Points.Release(), 3 * n, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+    meshfree::AdoptBulk(xyz, cloud.Points.Release(), 3 * n);
     points->SetData(xyz);
   }
   else
@@ -193,7 +193,7 @@ int vtkMeshFreePCDReader::RequestData(
       }
       auto colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
       colors->SetNumberOfComponents(comps);
-      colors->SetArray(dst, static_cast<vtkIdType>(n) * comps, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+      meshfree::AdoptBulk(colors, dst, static_cast<vtkIdType>(n) * comps);
       const unsigned char* src = cloud.Columns[c].Data();
       for (vtkIdType i = 0; i < n; ++i)
       {
@@ -211,8 +211,7 @@ int vtkMeshFreePCDReader::RequestData(
     {
       array.TakeReference(vtkDataArray::CreateDataArray(VTKType(f)));
       array->SetNumberOfComponents(f.Count);
-      array->SetVoidArray(cloud.Columns[c].Release(), static_cast<vtkIdType>(n) * f.Count, 0,
-        vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+      meshfree::AdoptBulk(array, cloud.Columns[c].Release(), static_cast<vtkIdType>(n) * f.Count);
     }
     array->SetName(name.c_str());
     output->GetPointData()->AddArray(array);

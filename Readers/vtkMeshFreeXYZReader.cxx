@@ -120,7 +120,7 @@ int vtkMeshFreeXYZReader::RequestData(
     outOfMemory = outOfMemory || !p;
     array->SetNumberOfComponents(components);
     if (p)
-      array->SetArray(p, n * components, 0, vtkAbstractArray::VTK_DATA_ARRAY_FREE);
+      meshfree::AdoptBulk(array, p, n * components);
     return p;
   };
 
