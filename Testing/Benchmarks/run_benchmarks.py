@@ -2,7 +2,7 @@
 
     MESHFREE_PLUGIN=<build>/lib/paraview-5.11/plugins/MeshFree/MeshFree.so \\
       pvpython --no-mpi Testing/Benchmarks/run_benchmarks.py [--quick | --smoke] [--out DIR] [--only PARTS]
-      [--threads N] [--rbf-global-limit N]
+      [--threads N] [--rbf-global-limit N] [--sizes N1,N2,...]
 
 The plugin comes from $MESHFREE_PLUGIN, else from <source>/build. --out defaults to
 <build>/benchmark-results. --only takes a comma list of approximation,sph,solid (default: all three).
@@ -836,9 +836,12 @@ def main():
                         help="largest N for SciPy's global RBF (default 10,000; 1,000 with --quick)")
     parser.add_argument("--threads", type=int, help="threads for every tool (OpenMP, VTK SMP, BLAS); default: "
                         "all cores. 1 gives a fair same-threads comparison on a loaded machine")
+    parser.add_argument("--sizes", help="comma list of N replacing the mode's (2D and 3D), e.g. 100000")
     parser.add_argument("--no-plots", action="store_true")
     args = parser.parse_args()
     cfg = Config("smoke" if args.smoke else "quick" if args.quick else "full")
+    if args.sizes:
+        cfg.sizes_2d = cfg.sizes_3d = tuple(int(v) for v in args.sizes.split(","))
     if args.rbf_global_limit is not None:
         cfg.rbf_global_limit = args.rbf_global_limit
     plugin = find_plugin()
