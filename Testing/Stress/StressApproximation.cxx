@@ -337,6 +337,81 @@ int StressApproximation(int, char*[])
     }
   }
 
+  // 4b. SPH without Shepard normalisation (the raw sum of V_j W_j f_j) on a lattice, with given volumes
+  // (Mass / Density) and estimated ones, at three scales: a constant field comes out close to 1 inside
+  // (partition of unity of the SPH kernel sum), and the same at every scale. Hostile Mass/Density
+  // values (zero, negative, NaN density) are excluded with a warning.
+  for (bool given : { true, false })
+  {
+    for (double scale : { 1e-6, 1.0, 1e6 })
+    {
+      suite.Begin(std::string("SPH raw sum, ") + (given ? "Mass/Density" : "estimated volumes") + ", scale " +
+        Str(scale));
+      const int m = 12;
+      const double d = scale / (m - 1);
+      vtkNew<vtkPolyData> lattice;
+      vtkNew<vtkPoints> pts;
+      pts->SetDataTypeToDouble();
+      vtkNew<vtkDoubleArray> f, mass, density;
+      f->SetName("F");
+      mass->SetName("Mass");
+      density->SetName("Density");
+      for (int k = 0; k < m; ++k)
+      {
+        for (int j = 0; j < m; ++j)
+        {
+          for (int i = 0; i < m; ++i)
+          {
+            pts->InsertNextPoint(i * d, j * d, k * d);
+            f->InsertNextValue(1.0);
+            mass->InsertNextValue(1000.0 * d * d * d);
+            density->InsertNextValue(1000.0);
+          }
+        }
+      }
+      // Three hostile rows: zero, negative and NaN density (excluded).
+      density->SetValue(0, 0.0);
+      density->SetValue(1, -5.0);
+      density->SetValue(2, std::numeric_limits<double>::quiet_NaN());
+      lattice->SetPoints(pts);
+      lattice->GetPointData()->AddArray(f);
+      if (given)
+      {
+        lattice->GetPointData()->AddArray(mass);
+        lattice->GetPointData()->AddArray(density);
+      }
+      vtkNew<vtkPolyData> probe;
+      vtkNew<vtkPoints> probePts;
+      for (int i = 0; i < 20; ++i)
+      {
+        probePts->InsertNextPoint(scale * (0.35 + 0.3 * Halton(i + 1, 2)), scale * (0.35 + 0.3 * Halton(i + 1, 3)),
+          scale * (0.35 + 0.3 * Halton(i + 1, 5)));
+      }
+      probe->SetPoints(probePts);
+      auto a = Make(4, 0);
+      a->SetShepardNormalization(false);
+      a->SetNeighborCount(40);
+      a->AddPointArray("F");
+      Result r = Run(a, lattice, probe);
+      CheckOutput(suite, r, -7.0);
+      suite.ExpectNoError();
+      if (given)
+      {
+        suite.ExpectWarning("NaN/Inf");
+      }
+      if (r.F)
+      {
+        double lo = 1e300, hi = -1e300;
+        for (vtkIdType i = 0; i < r.F->GetNumberOfTuples(); ++i)
+        {
+          lo = std::min(lo, r.F->GetComponent(i, 0));
+          hi = std::max(hi, r.F->GetComponent(i, 0));
+        }
+        suite.Check(lo > 0.8 && hi < 1.2, "the raw SPH sum of a constant field is " + Str(lo) + " .. " + Str(hi));
+      }
+    }
+  }
+
   // 5. Hostile parameters: NaN NullValue, NaN Center, a degenerate grid, a collinear height field.
   {
     suite.Begin("NullValue NaN");
