@@ -403,15 +403,49 @@ bool Parse(const char* data, std::size_t size, Table& table, std::string& error)
   return ParseImpl(data, size, false, table, error);
 }
 
-bool LooksLikeCloud(const char* data, std::size_t size)
+bool LooksBinary(const char* data, std::size_t size)
 {
-  std::size_t n = std::min(size, SniffBytes);
+  const std::size_t n = std::min(size, SniffBytes);
   for (std::size_t i = 0; i < n; ++i)
   {
     const unsigned char c = static_cast<unsigned char>(data[i]);
     if (c == 0 || (c < 32 && c != '\n' && c != '\r' && c != '\t' && c != '\f' && c != '\v'))
-      return false; // binary: PLOT3D grids and the like
+      return true;
   }
+  return false;
+}
+
+bool LooksLikePlot3D(const char* data, std::size_t size)
+{
+  auto word = [&](std::size_t at, bool big) {
+    unsigned char b[4];
+    std::memcpy(b, data + at, 4);
+    const std::uint32_t u = big ? (std::uint32_t(b[0]) << 24 | std::uint32_t(b[1]) << 16 | std::uint32_t(b[2]) << 8 | b[3])
+                                : (std::uint32_t(b[3]) << 24 | std::uint32_t(b[2]) << 16 | std::uint32_t(b[1]) << 8 | b[0]);
+    return static_cast<std::int64_t>(static_cast<std::int32_t>(u));
+  };
+  constexpr std::int64_t MaxCount = 100000000;
+  for (bool big : { false, true })
+  {
+    if (size < 8)
+      continue;
+    const std::int64_t first = word(0, big), second = word(4, big);
+    // Fortran unformatted: <n> n bytes <n>.
+    if (first > 0 && first % 4 == 0 && static_cast<std::uint64_t>(first) + 8 <= size &&
+      word(4 + static_cast<std::size_t>(first), big) == first)
+      return true;
+    // C binary: the number of grids, or the first dimensions, as positive counts.
+    if (first >= 1 && first <= MaxCount && second >= 1 && second <= MaxCount)
+      return true;
+  }
+  return false;
+}
+
+bool LooksLikeCloud(const char* data, std::size_t size)
+{
+  std::size_t n = std::min(size, SniffBytes);
+  if (LooksBinary(data, n))
+    return false; // binary: PLOT3D grids and the like
   if (n < size)
   {
     // Only whole lines of the window.

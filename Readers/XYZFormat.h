@@ -68,6 +68,15 @@ bool Parse(const char* data, std::size_t size, Table& table, std::string& error)
 /// tell point clouds from the other formats that use ".xyz" (PLOT3D grids, XMol molecules).
 bool LooksLikeCloud(const char* data, std::size_t size);
 
+/// True when the start of data has NUL or other control bytes (not a text file).
+bool LooksBinary(const char* data, std::size_t size);
+
+/// True when the start of a binary file could be a PLOT3D grid (ParaView's other ".xyz" reader): in one byte
+/// order, a Fortran record (a length marker repeated after the record), or two positive counts (grids,
+/// dimensions) first. Binary files failing this are no grid: the text-cloud reader claims them and refuses
+/// them with an error, rather than leaving them to the PLOT3D reader, which aborts the process on garbage.
+bool LooksLikePlot3D(const char* data, std::size_t size);
+
 } // namespace xyz
 } // namespace meshfree
 

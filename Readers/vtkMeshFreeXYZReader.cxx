@@ -51,7 +51,14 @@ int vtkMeshFreeXYZReader::CanReadFile(const char* filename)
   std::string start;
   if (!meshfree::ReadFileStart(filename, 64 * 1024, start))
     return 0;
-  return meshfree::xyz::LooksLikeCloud(start.data(), start.size()) ? 1 : 0;
+  if (meshfree::xyz::LooksLikeCloud(start.data(), start.size()))
+    return 1;
+  // A binary file that cannot be a PLOT3D grid either (a damaged file): claimed, to be refused with an
+  // error by RequestData, because ParaView's PLOT3D reader, the other reader of ".xyz", aborts on such data.
+  return meshfree::xyz::LooksBinary(start.data(), start.size()) &&
+      !meshfree::xyz::LooksLikePlot3D(start.data(), start.size())
+    ? 1
+    : 0;
 }
 
 int vtkMeshFreeXYZReader::RequestData(
@@ -67,7 +74,13 @@ int vtkMeshFreeXYZReader::RequestData(
   meshfree::pcd::MappedFile file;
   meshfree::xyz::Table table;
   std::string error;
-  if (!file.Open(this->FileName, error) || !meshfree::xyz::Parse(file.Data(), file.Size(), table, error))
+  if (file.Open(this->FileName, error) && meshfree::xyz::LooksBinary(file.Data(), file.Size()))
+  {
+    vtkErrorMacro("Cannot read '" << this->FileName
+                                  << "': it holds binary data (NUL or control bytes), not a text point cloud.");
+    return 1;
+  }
+  if (!error.empty() || !meshfree::xyz::Parse(file.Data(), file.Size(), table, error))
   {
     vtkErrorMacro("Cannot read '" << this->FileName << "': " << error);
     return 1;

@@ -298,3 +298,20 @@ TEST(ReadersVTK, XYZReaderDropsOrKeepsInvalidRowsWithAlignedArrays)
   EXPECT_EQ(out->GetNumberOfPoints(), 0);
   EXPECT_EQ(out->GetNumberOfVerts(), 0);
 }
+
+TEST(ReadersVTK, XYZReaderClaimsAndRefusesDamagedBinaryFiles)
+{
+  const std::string path = OutFile("damaged.xyz");
+  WriteText(path, std::string("\x00\x01\x02\xff\xfe\n\x00\x00", 8));
+  vtkNew<vtkMeshFreeXYZReader> probe;
+  EXPECT_EQ(probe->CanReadFile(path.c_str()), 1); // not left to the PLOT3D reader, which aborts on it
+  vtkNew<MessageCatcher> msg;
+  auto out = Read<vtkMeshFreeXYZReader>(path, msg);
+  EXPECT_NE(msg->Errors.find("binary data"), std::string::npos) << msg->Errors;
+  EXPECT_EQ(out->GetNumberOfPoints(), 0);
+  EXPECT_EQ(out->GetNumberOfCells(), 0);
+  // A PLOT3D grid (Fortran records) is still declined.
+  const unsigned char grid[] = { 12, 0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 12, 0, 0, 0, 48, 0, 0, 0 };
+  WriteText(path, std::string(reinterpret_cast<const char*>(grid), sizeof(grid)));
+  EXPECT_EQ(probe->CanReadFile(path.c_str()), 0);
+}

@@ -177,3 +177,25 @@ TEST(XYZFormat, ShortRowsAfterAWideRowFailWithoutAllocating)
     text += "1\n";
   EXPECT_NE(MustFail(text).find("line 2: 1 columns where the cloud has 5000"), std::string::npos) << MustFail(text);
 }
+
+// Damaged binary ".xyz" files: not a text cloud and not a PLOT3D grid (the text-cloud reader claims them, to
+// refuse them itself: ParaView's PLOT3D reader aborts on them). Real PLOT3D grids keep going to PLOT3D.
+TEST(XYZFormat, BinaryFilesThatCannotBePlot3DGrids)
+{
+  const std::string garbage("\x00\x01\x02\xff\xfe\n\x00\x00", 8); // STRESS's reproducer
+  EXPECT_TRUE(LooksBinary(garbage.data(), garbage.size()));
+  EXPECT_FALSE(LooksLikeCloud(garbage.data(), garbage.size()));
+  EXPECT_FALSE(LooksLikePlot3D(garbage.data(), garbage.size()));
+  const unsigned char tiny[] = { 0xff, 0xff, 0xff, 0xff };
+  EXPECT_FALSE(LooksLikePlot3D(reinterpret_cast<const char*>(tiny), sizeof(tiny)));
+  // Fortran records, little and big endian: 12 | 3 ints | 12 | ...
+  const unsigned char fortranLE[] = { 12, 0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 12, 0, 0, 0, 48, 0, 0, 0 };
+  const unsigned char fortranBE[] = { 0, 0, 0, 12, 0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 12, 0, 0, 0, 48 };
+  EXPECT_TRUE(LooksLikePlot3D(reinterpret_cast<const char*>(fortranLE), sizeof(fortranLE)));
+  EXPECT_TRUE(LooksLikePlot3D(reinterpret_cast<const char*>(fortranBE), sizeof(fortranBE)));
+  // C binary without record markers: ni nj nk first.
+  const unsigned char plain[] = { 3, 0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 0, 0, 0, 0 };
+  EXPECT_TRUE(LooksLikePlot3D(reinterpret_cast<const char*>(plain), sizeof(plain)));
+  const std::string text = "1 2 3\n";
+  EXPECT_FALSE(LooksBinary(text.data(), text.size()));
+}
