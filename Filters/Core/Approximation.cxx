@@ -338,7 +338,9 @@ int Approximator::MLSShape(const double x[3], FitScratch& s, bool gradient, bool
 {
   result = PointResult{ false, 0, 0.0, false, false };
   const int D = this->Frame.Dimension;
-  int k = this->Opts.NeighborCount;
+  // A moving fit needs clearly more neighbours than basis terms: with k equal to the basis size (20 for
+  // cubics in 3D, the default NeighborCount) each fit nearly interpolates and overshoots between points.
+  int k = std::max(this->Opts.NeighborCount, kMinimumNeighborsPerTerm * BasisSize(std::max(D, 0), this->Opts.Degree));
   double radius = this->Opts.SupportRadius;
   const double* coords = this->Coordinates.data();
   for (int attempt = 0; attempt < 2; ++attempt)

@@ -28,7 +28,8 @@
  *
  * Support radius: with SupportRadius <= 0, h = SupportFactor * (distance to the NeighborCount-th nearest
  * point) at each evaluation point, so that exactly NeighborCount points carry weight (SupportFactor = 1.1);
- * SupportRadius > 0 fixes h.
+ * SupportRadius > 0 fixes h. MLS uses at least kMinimumNeighborsPerTerm x the basis size neighbours (40 for
+ * cubics in 3D): fewer make each moving fit nearly interpolating and ill-conditioned.
  *
  * Dimension: the cloud's intrinsic dimension (0..3) comes from a PCA of the valid points (axes with a
  * standard deviation below 3e-7 of the largest are flat); the basis uses the intrinsic axes (the coordinate

@@ -37,6 +37,8 @@ namespace meshfree
 
 /// A fit whose equilibrated moment matrix has a larger condition number is degenerate.
 constexpr double kMaxCondition = 1e10;
+/// MLS: the moving fit uses at least this many neighbours per basis term (see Approximation.h).
+constexpr int kMinimumNeighborsPerTerm = 2;
 /// Below this LDLT pivot ratio the fast path is trusted; above it the eigen-decomposition decides.
 constexpr double kFastPathRatio = 1e6;
 
