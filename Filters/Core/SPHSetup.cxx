@@ -19,6 +19,7 @@ namespace
 constexpr double Pi = 3.141592653589793238462643383279502884;
 constexpr Index MaximumParticles = 100000000;
 constexpr double StabilityLambda = 0.4; // as in SPHFluid.cxx: the largest stable CFL factor
+constexpr double MaximumSupport = 20.0;  // largest SmoothingLength / ParticleSpacing accepted
 
 bool Finite(const double* v, int n)
 {
@@ -151,6 +152,37 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
   const double dx = p.ParticleSpacing;
   this->H = p.SmoothingLength > 0.0 ? p.SmoothingLength : 2.0 * dx;
   this->H2 = this->H * this->H;
+  if (this->H > MaximumSupport * dx)
+  {
+    std::ostringstream s;
+    s << "SmoothingLength " << this->H << " is " << this->H / dx << " particle spacings; at most " << MaximumSupport
+      << " are supported (neighbour counts and wall layers grow as (h/dx)^d; 1.5 to 6, default 2, is sensible)";
+    fail(s.str());
+  }
+  if (p.Walls)
+  {
+    // The wall shell holds about prod(n_a + 2 L) - prod(n_a) dummies (L = h/dx layers): refuse before
+    // allocating what cannot fit.
+    const double layersD = std::ceil(this->H / dx);
+    double outer = 1.0, inner = 1.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (a == 1 && d == 2)
+      {
+        continue;
+      }
+      const double cells = std::max(1.0, std::floor((p.DomainBounds[2 * a + 1] - p.DomainBounds[2 * a]) / dx + 0.5));
+      outer *= cells + 2.0 * layersD;
+      inner *= cells;
+    }
+    if (!(outer - inner <= static_cast<double>(MaximumParticles)))
+    {
+      std::ostringstream s;
+      s << "DomainBounds / ParticleSpacing would need " << outer - inner << " wall particles (more than "
+        << MaximumParticles << "): the container is too large for this spacing";
+      fail(s.str());
+    }
+  }
   if (this->H < 1.5 * dx || this->H > 6.0 * dx)
   {
     std::ostringstream s;

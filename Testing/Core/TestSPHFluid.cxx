@@ -266,6 +266,13 @@ TEST(SPHFluid, HostileSettings)
     EXPECT_THROW(fluid.Setup(q), std::invalid_argument);
     q.ArtificialViscosity = std::nan("");
     EXPECT_THROW(fluid.Setup(q), std::invalid_argument);
+    q.ArtificialViscosity = 0.02;
+    q.SmoothingLength = 100.0; // 10,000 spacings: would need ~10^8 wall particles; refused, not allocated
+    EXPECT_THROW(fluid.Setup(q), std::invalid_argument);
+    q.SmoothingLength = 0.0;
+    q.Dimension = 3;
+    SetBox(q.DomainBounds, { 0.0, 100.0, 0.0, 100.0, 0.0, 100.0 }); // 10^4 spacings a side: 6 * 10^8 dummies
+    EXPECT_THROW(fluid.Setup(q), std::invalid_argument);
   }
   { // zero particles: an empty block
     SPHParameters q = p;
