@@ -76,7 +76,7 @@ bool Inside(vtkPolyData* p, const double b[6], int dim, double tol)
 // run only in PendingSPHFluid (compiled into the driver, not registered with ctest until fixed).
 bool IsPending(const std::string& name)
 {
-  static const char* pending[] = { "KernelPair 2", "CFLNumber 10", "ParticleSpacing 1e-7", "SmoothingLength 100",
+  static const char* pending[] = { "ParticleSpacing 1e-7", "SmoothingLength 100",
     "EndTime NaN", "OutputInterval 0", "OutputInterval Inf", "obstacle with NaN vertices" };
   for (const char* p : pending)
   {
@@ -144,7 +144,9 @@ int RunSPHStress(bool pendingOnly)
         }
         CheckFinite(suite, p);
         const double e = SpecificEnergy(p, g);
-        if (!suite.Check(e <= e0 + 0.02 * scale,
+        // The 'Mueller' pair (poly6 density, spiky pressure gradient) is documented as not conservative:
+        // it warns instead (checked below); the others must not create energy.
+        if (kernels != 2 && !suite.Check(e <= e0 + 0.02 * scale,
               "energy grew from " + Str(e0) + " to " + Str(e) + " at t = " + Str(t)))
         {
           break;
@@ -157,6 +159,10 @@ int RunSPHStress(bool pendingOnly)
         suite.Check(ids && ids->GetRange(0)[0] == 0 && ids->GetRange(0)[1] == n - 1, "Id not 0..n-1");
       }
       suite.ExpectNoError();
+      if (kernels == 2)
+      {
+        suite.ExpectWarning("conserve energy");
+      }
     }
   }
 
