@@ -403,6 +403,8 @@ int vtkMeshFreeDeformableSolid::RequestData(
     maxStep = 20.0 * impl.Solid.StableTimeStep();
   }
   const long total = step - found;
+  const long unconvergedBefore = impl.Solid.UnconvergedCGSteps();
+  const long stepsBefore = impl.Solid.StepsTaken();
   for (long s = found + 1; s <= step; ++s)
   {
     bool aborted = false;
@@ -435,6 +437,14 @@ int vtkMeshFreeDeformableSolid::RequestData(
     this->UpdateProgress(static_cast<double>(s - found) / static_cast<double>(std::max(1L, total)));
   }
   this->ConjugateGradientIterations = static_cast<int>(impl.Solid.CGIterations());
+  if (impl.Solid.UnconvergedCGSteps() > unconvergedBefore)
+  {
+    vtkWarningMacro("Implicit integrator: the conjugate gradient stopped at its iteration cap before reaching "
+                    "its tolerance on "
+      << impl.Solid.UnconvergedCGSteps() - unconvergedBefore << " of " << impl.Solid.StepsTaken() - stepsBefore
+      << " steps (relative residual up to " << impl.Solid.WorstCGResidual()
+      << "): those steps are approximate. A smaller TimeStep converges in fewer iterations.");
+  }
 
   // Phyxels block: positions and the fields of this state (strain and stress computed here only).
   const meshfree::ElasticSolid& solid = impl.Solid;

@@ -309,6 +309,11 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
     }
   }
   residual = bnorm > 0.0 ? rnorm / bnorm : 0.0;
+  if (it >= maxIterations && residual > tolerance)
+  {
+    ++this->UnconvergedSteps;
+    this->WorstResidual = std::max(this->WorstResidual, residual);
+  }
 
 #pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
   for (Index i = 0; i < n; ++i)

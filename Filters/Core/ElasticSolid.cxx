@@ -363,6 +363,8 @@ bool ElasticSolid::Initialize(
   this->Current.PlasticStrain.assign(s.PlasticYield > 0.0 ? 6 * n : 0, 0.0);
   this->Steps = 0;
   this->TotalCGIterations = 0;
+  this->UnconvergedSteps = 0;
+  this->WorstResidual = 0.0;
 
   if (illConditioned > 0)
   {

@@ -153,6 +153,10 @@ public:
   bool Advance(double duration, double maxStep, bool implicit, const std::function<bool()>& abort = {});
   long StepsTaken() const { return this->Steps; }
   long CGIterations() const { return this->TotalCGIterations; }
+  /// Implicit steps whose conjugate gradient stopped at maxIterations above the tolerance, and the largest
+  /// relative residual left (since Initialize).
+  long UnconvergedCGSteps() const { return this->UnconvergedSteps; }
+  double WorstCGResidual() const { return this->WorstResidual; }
 
 private:
   // Pass 1: per phyxel the packet G_i = v_i P_i, F_i, the force phyxel i puts on itself, and the hourglass
@@ -203,6 +207,8 @@ private:
   mutable std::vector<double> Force, Packet, DefGrad, SelfForce, EdgeForce;
   long Steps = 0;
   long TotalCGIterations = 0;
+  long UnconvergedSteps = 0;
+  double WorstResidual = 0.0;
 };
 
 /// Isotropic Hooke law on the 6-vector (xx, yy, zz, xy, yz, xz) of tensor components [4.6-4.7].
