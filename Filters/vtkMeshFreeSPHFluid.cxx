@@ -69,19 +69,32 @@ std::vector<double> OutputTimes(double end, double interval)
 }
 
 // Triangles of the polygons and strips of `surface`, 9 doubles each (fan triangulation of polygons).
-std::vector<double> Triangles(vtkPolyData* surface)
+// Triangles with a NaN or infinite vertex are left out and counted in `skipped`.
+std::vector<double> Triangles(vtkPolyData* surface, long& skipped)
 {
   std::vector<double> out;
+  skipped = 0;
   if (!surface || surface->GetNumberOfPoints() == 0)
   {
     return out;
   }
   auto add = [&](vtkIdType a, vtkIdType b, vtkIdType c) {
-    double p[3];
+    double p[9];
+    bool finite = true;
+    int v = 0;
     for (vtkIdType id : { a, b, c })
     {
-      surface->GetPoint(id, p);
-      out.insert(out.end(), p, p + 3);
+      surface->GetPoint(id, p + 3 * v);
+      finite = finite && std::isfinite(p[3 * v]) && std::isfinite(p[3 * v + 1]) && std::isfinite(p[3 * v + 2]);
+      ++v;
+    }
+    if (finite)
+    {
+      out.insert(out.end(), p, p + 9);
+    }
+    else
+    {
+      ++skipped;
     }
   };
   vtkIdType n;
@@ -106,6 +119,12 @@ std::vector<double> Triangles(vtkPolyData* surface)
 }
 }
 
+bool vtkMeshFreeSPHFluid::ValidTimes() const
+{
+  return this->OutputInterval > 0.0 && std::isfinite(this->OutputInterval) && this->EndTime >= 0.0 &&
+    std::isfinite(this->EndTime);
+}
+
 int vtkMeshFreeSPHFluid::GetNumberOfOutputTimes()
 {
   return static_cast<int>(OutputTimes(this->EndTime, this->OutputInterval).size());
@@ -114,10 +133,10 @@ int vtkMeshFreeSPHFluid::GetNumberOfOutputTimes()
 int vtkMeshFreeSPHFluid::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  if (!(this->OutputInterval > 0.0) || !(this->EndTime >= 0.0))
+  if (!this->ValidTimes())
   {
-    vtkErrorMacro("OutputInterval must be > 0 and EndTime >= 0 (got " << this->OutputInterval << ", "
-                                                                      << this->EndTime << ")");
+    vtkErrorMacro("OutputInterval must be finite and > 0, and EndTime finite and >= 0 (got "
+      << this->OutputInterval << ", " << this->EndTime << "); the output is empty");
   }
   this->Impl->Times = OutputTimes(this->EndTime, this->OutputInterval);
   const std::vector<double>& times = this->Impl->Times;
@@ -134,6 +153,10 @@ int vtkMeshFreeSPHFluid::RequestData(
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   Internals& impl = *this->Impl;
+  if (!this->ValidTimes())
+  {
+    return 1; // empty output, the error has been reported by RequestInformation
+  }
   if (impl.Times.empty())
   {
     impl.Times = OutputTimes(this->EndTime, this->OutputInterval);
@@ -189,7 +212,14 @@ int vtkMeshFreeSPHFluid::RequestData(
     impl.SetupFailed = false;
     try
     {
-      impl.Solver.Setup(p, Triangles(obstacles));
+      long skipped = 0;
+      const std::vector<double> triangles = Triangles(obstacles, skipped);
+      if (skipped > 0)
+      {
+        vtkWarningMacro("SPH Fluid: " << skipped
+                                      << " Obstacles triangles with a NaN or infinite vertex were left out");
+      }
+      impl.Solver.Setup(p, triangles);
       meshfree::SPHState initial = impl.Solver.InitialState();
       impl.Cache.Insert(0, std::move(initial));
     }

@@ -155,6 +155,9 @@ public:
   /** Number of simulation steps taken by this object since its creation (for tests of the cache). */
   vtkGetMacro(StepsTaken, long);
 
+  /** Whether OutputInterval and EndTime are usable (finite, > 0 and >= 0). */
+  bool ValidTimes() const;
+
   /** The output times reported by RequestInformation (for tests). */
   int GetNumberOfOutputTimes();
 

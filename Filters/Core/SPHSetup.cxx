@@ -152,6 +152,24 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
   const double dx = p.ParticleSpacing;
   this->H = p.SmoothingLength > 0.0 ? p.SmoothingLength : 2.0 * dx;
   this->H2 = this->H * this->H;
+  {
+    // The fluid lattice, refused here (before the wall shell is allocated) rather than in InitialState().
+    double total = 1.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (!(a == 1 && d == 2))
+      {
+        total *= std::max(0.0, std::floor((p.FluidBounds[2 * a + 1] - p.FluidBounds[2 * a]) / dx + 0.5));
+      }
+    }
+    if (total > static_cast<double>(MaximumParticles))
+    {
+      std::ostringstream s;
+      s << "FluidBounds / ParticleSpacing would create " << total << " particles (more than " << MaximumParticles
+        << ")";
+      fail(s.str());
+    }
+  }
   if (this->H > MaximumSupport * dx)
   {
     std::ostringstream s;
