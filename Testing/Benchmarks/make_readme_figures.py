@@ -1,0 +1,50 @@
+#!/usr/bin/env python3
+"""Montage of the demo's thesis figures for the README (one small PNG).
+
+Usage: python3 Testing/Benchmarks/make_readme_figures.py [DEMO_DIR] [OUT_PNG]
+DEMO_DIR defaults to build/demo (written by ./run.sh demo); OUT_PNG to Testing/Benchmarks/results/demo_figures.png.
+Needs Debian's python3-matplotlib.
+"""
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.image as mpimg  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+
+PANELS = [
+    ("fig3_1_ls.png", "3.1 LS"),
+    ("fig3_2_wls.png", "3.2 WLS"),
+    ("fig3_3_mls.png", "3.3 MLS"),
+    ("fig3_4_sph.png", "3.4 SPH"),
+    ("fig3_5_mls_256.png", "3.5 MLS, 256 random points"),
+    ("fig4_6_solid.png", "4.6 octahedron solid"),
+    ("fig4_7_solid.png", "4.7 ellipsoid solid"),
+    ("fig4_8_solid.png", "4.8 ellipsoid with its surface"),
+    ("fig5_8_sph_65536.png", "5.8 SPH dam break, 65,536 particles"),
+    ("dambreak_005.png", "3D dam break (demo)"),
+]
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(os.path.dirname(here))
+    demo = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build", "demo")
+    out = sys.argv[2] if len(sys.argv) > 2 else os.path.join(here, "results", "demo_figures.png")
+    missing = [f for f, _ in PANELS if not os.path.isfile(os.path.join(demo, f))]
+    if missing:
+        sys.exit("missing demo pictures in %s (run ./run.sh demo first): %s" % (demo, ", ".join(missing)))
+    fig, axes = plt.subplots(2, 5, figsize=(15, 5.4))
+    for ax, (name, title) in zip(axes.flat, PANELS):
+        ax.imshow(mpimg.imread(os.path.join(demo, name)))
+        ax.set_title(title, fontsize=9)
+        ax.axis("off")
+    fig.tight_layout()
+    fig.savefig(out, dpi=80)
+    print("wrote", out)
+
+
+if __name__ == "__main__":
+    main()
