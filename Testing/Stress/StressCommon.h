@@ -5,6 +5,8 @@
 #ifndef MeshFreeStressCommon_h
 #define MeshFreeStressCommon_h
 
+#include "TestFunctions.h"
+
 #include "vtkCellArray.h"
 #include "vtkCompositeDataIterator.h"
 #include "vtkCompositeDataSet.h"
@@ -240,16 +242,7 @@ inline std::string Str(double v)
   return buffer;
 }
 
-inline double Halton(int i, int base)
-{
-  double f = 1.0, r = 0.0;
-  for (; i > 0; i /= base)
-  {
-    f /= base;
-    r += f * (i % base);
-  }
-  return r;
-}
+using meshfree::testing::Halton;
 
 // Hostile clouds. Each has point arrays "F" (1 component, a smooth function of the position) and "V"
 // (3 components), unless said otherwise.
