@@ -9,10 +9,10 @@ The script checks what it shows (an AssertionError otherwise): the phyxel count 
 rule (a cubic lattice of PhyxelSpacing centred in the shape's bounds, the points inside the shape or the
 surface), computed here on its own; every point and value is finite; the solid fell and stayed in its
 container; the embedded surface follows the phyxels (same displacement of the centroid, every surface vertex
-near a phyxel). The counts are this lattice's, not the thesis' (299, 568, 715 came from its own samplings;
-Data/*.pcd holds those clouds).
-  4.6: 377 phyxels; 4.7: 576; 4.8: 946 (the surface lies half a spacing outside the 715 phyxels of
-  Data/ellipsoid_715.pcd, and the solid fills all of its inside)."""
+near a phyxel). The counts are this lattice's; the spacings are chosen to come closest to the thesis'
+(299, 568, 715 came from its own samplings; Data/*.pcd holds those clouds):
+  4.6: 377 phyxels (the lattice count jumps to 280 at spacing 0.1615, which leaves the apexes 1.8 spacings
+  from the nearest phyxel); 4.7: 576; 4.8: 728."""
 import os
 import sys
 
@@ -31,7 +31,7 @@ def solid(figure):
     if figure == "4.8":
         surface = simple.OpenDataFile(fc.data("ellipsoid_715_surface.ply"))
         s = MLSDeformableSolid(Input=surface)  # noqa: F821
-        s.PhyxelSpacing = 0.11856
+        s.PhyxelSpacing = 0.13
         s.Container = "Cylinder"
         s.ContainerBounds = [-1.6, 1.6, -1.6, 1.6, -1.2, 3.0]
         s.YoungModulus, s.PoissonRatio, s.Density, s.WeightFunction = 100.0, 0.2, 5.0, "Poly6"
