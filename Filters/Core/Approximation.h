@@ -176,6 +176,13 @@ private:
   PointResult PUPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const;
   int Neighbors(const double x[3], int k, double radius, FitScratch& s, double& h) const;
+  /// Keeps those of the n neighbours s.Ids/s.Dist2 of x with a positive, finite weight W(r / h)^2, packed at
+  /// the front of s.Ids and s.Weights, with their local coordinates (x_j - x) / h in the frame in s.Xi;
+  /// returns how many. s must hold room for n (FitScratch::Reserve).
+  int GatherWeighted(const double x[3], int n, double h, FitScratch& s) const;
+  /// Least-squares fit of every component over the m gathered neighbours of s, from the requested degree
+  /// down to `lowest` (the first that succeeds); returns the degree used, -1 when none does.
+  int FitDescending(int lowest, const FitScratch& s, int m, double* coefficients, double& condition) const;
   void Mask(const ApproximationOutput& out, Index i) const;
 
   ApproximationOptions Opts;

@@ -127,39 +127,12 @@ bool Approximator::PrepareGlobalFit()
     const int n = this->Neighbors(center, k, radius, s, h);
     s.Reserve(static_cast<size_t>(std::max(n, 1)));
     this->GlobalInvScale = 1.0 / h;
-    int m = 0;
-    for (int j = 0; j < n; ++j)
+    const int m = this->GatherWeighted(center, n, h, s);
+    this->GlobalDegree = this->FitDescending(
+      attempt == 0 ? this->Opts.Degree : 0, s, m, this->GlobalCoefficients.data(), this->GlobalCondition);
+    if (this->GlobalDegree >= 0)
     {
-      const double w = this->UnitKernel.ValueSquared(s.Dist2[j] / (h * h));
-      if (!(w > 0.0) || !std::isfinite(w))
-      {
-        continue;
-      }
-      const Index id = s.Ids[j];
-      const double dx[3] = { this->Coordinates[3 * id] - center[0], this->Coordinates[3 * id + 1] - center[1],
-        this->Coordinates[3 * id + 2] - center[2] };
-      double* xi = &s.Xi[3 * m];
-      xi[0] = xi[1] = xi[2] = 0.0;
-      this->Frame.Project<3>(dx, this->GlobalInvScale, xi);
-      for (int a = D; a < 3; ++a)
-      {
-        xi[a] = 0.0;
-      }
-      s.Ids[m] = id;
-      s.Weights[m] = w;
-      ++m;
-    }
-    const int lowest = attempt == 0 ? this->Opts.Degree : 0;
-    for (int degree = this->Opts.Degree; m > 0 && degree >= lowest; --degree)
-    {
-      if (ComputeFitCoefficients(D, degree, s.Xi.data(), s.Weights.data(), m, s.Ids.data(),
-            this->Values.data(), C, this->Opts.Diagnostics, this->GlobalCoefficients.data(),
-            this->GlobalCondition))
-      {
-        this->GlobalDegree = degree;
-        this->GlobalNeighbors = m;
-        break;
-      }
+      this->GlobalNeighbors = m;
     }
     k *= 2;
     radius *= 2.0;
@@ -362,6 +335,47 @@ bool Approximator::Evaluate(
   this->Rep.Widened += widened;
   this->Rep.DegreeLowered += lowered;
   return true;
+}
+
+int Approximator::GatherWeighted(const double x[3], int n, double h, FitScratch& s) const
+{
+  const int D = this->Frame.Dimension;
+  const double invH = 1.0 / h;
+  int m = 0;
+  for (int j = 0; j < n; ++j)
+  {
+    const double w = this->UnitKernel.ValueSquared(s.Dist2[j] / (h * h));
+    if (!(w > 0.0) || !std::isfinite(w))
+    {
+      continue;
+    }
+    const Index id = s.Ids[j];
+    const double dx[3] = { this->Coordinates[3 * id] - x[0], this->Coordinates[3 * id + 1] - x[1],
+      this->Coordinates[3 * id + 2] - x[2] };
+    double* xi = &s.Xi[3 * m];
+    this->Frame.Project<3>(dx, invH, xi);
+    for (int a = D; a < 3; ++a)
+    {
+      xi[a] = 0.0;
+    }
+    s.Ids[m] = id;
+    s.Weights[m] = w;
+    ++m;
+  }
+  return m;
+}
+
+int Approximator::FitDescending(int lowest, const FitScratch& s, int m, double* coefficients, double& condition) const
+{
+  for (int degree = this->Opts.Degree; m > 0 && degree >= lowest; --degree)
+  {
+    if (ComputeFitCoefficients(this->Frame.Dimension, degree, s.Xi.data(), s.Weights.data(), m, s.Ids.data(),
+          this->Values.data(), this->NumberOfComponents, this->Opts.Diagnostics, coefficients, condition))
+    {
+      return degree;
+    }
+  }
+  return -1;
 }
 
 } // namespace meshfree

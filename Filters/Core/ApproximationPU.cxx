@@ -141,34 +141,13 @@ bool Approximator::PreparePU()
           }
         }
         s.Reserve(static_cast<size_t>(std::max(n, 1)));
-        int m = 0;
-        for (int j = 0; j < n; ++j)
+        const int m = this->GatherWeighted(x, n, h, s);
+        degrees[node] = this->FitDescending(
+          attempt == 0 ? this->Opts.Degree : 0, s, m, &coefficients[stride * node], conditions[node]);
+        if (degrees[node] >= 0)
         {
-          const double w = this->UnitKernel.ValueSquared(s.Dist2[j] / (h * h));
-          if (!(w > 0.0) || !std::isfinite(w))
-          {
-            continue;
-          }
-          const Index id = s.Ids[j];
-          const double dx[3] = { this->Coordinates[3 * id] - x[0], this->Coordinates[3 * id + 1] - x[1],
-            this->Coordinates[3 * id + 2] - x[2] };
-          double* xi = &s.Xi[3 * m];
-          this->Frame.Project<3>(dx, 1.0 / h, xi);
-          s.Ids[m] = id;
-          s.Weights[m] = w;
-          ++m;
-        }
-        const int lowest = attempt == 0 ? this->Opts.Degree : 0;
-        for (int degree = this->Opts.Degree; m > 0 && degree >= lowest; --degree)
-        {
-          if (ComputeFitCoefficients(D, degree, s.Xi.data(), s.Weights.data(), m, s.Ids.data(),
-                this->Values.data(), C, this->Opts.Diagnostics, &coefficients[stride * node], conditions[node]))
-          {
-            degrees[node] = degree;
-            fitCounts[node] = m;
-            supports[node] = h;
-            break;
-          }
+          fitCounts[node] = m;
+          supports[node] = h;
         }
       }
     }
