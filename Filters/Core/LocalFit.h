@@ -71,6 +71,58 @@ struct LocalFrame
 };
 
 /**
+ * The equilibrating scales s_i = 1 / sqrt(M_ii) of a moment matrix (S M S has a unit diagonal); `diagonal(i)`
+ * gives M_ii. False, with an infinite condition, when M_00 is not positive and finite or a monomial
+ * (numerically) vanishes on every neighbour - the points lie on its zero set (M_ii <= 1e-28 M_00).
+ */
+template <int Q, class Diagonal>
+bool EquilibrationScales(const Diagonal& diagonal, double* s, double& condition)
+{
+  const double m00 = diagonal(0);
+  if (!(m00 > 0.0) || !std::isfinite(m00))
+  {
+    condition = std::numeric_limits<double>::infinity();
+    return false;
+  }
+  for (int i = 0; i < Q; ++i)
+  {
+    const double d = diagonal(i);
+    if (!(d > 1e-28 * m00))
+    {
+      condition = std::numeric_limits<double>::infinity();
+      return false;
+    }
+    s[i] = 1.0 / std::sqrt(d);
+  }
+  return true;
+}
+
+/**
+ * The robust path of the moment solves: the eigen-decomposition of the equilibrated matrix M. False when it
+ * fails or kappa(M) >= kMaxCondition; `condition` receives kappa(M) (infinite when not positive definite).
+ */
+template <int Q>
+bool RobustDecomposition(
+  const Eigen::Matrix<double, Q, Q>& M, Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Q, Q>>& eig, double& condition)
+{
+  eig.compute(M);
+  if (eig.info() != Eigen::Success)
+  {
+    condition = std::numeric_limits<double>::infinity();
+    return false;
+  }
+  const double lmax = eig.eigenvalues()(Q - 1); // ascending
+  const double lmin = eig.eigenvalues()(0);
+  if (!(lmin > 0.0) || !(lmax < kMaxCondition * lmin))
+  {
+    condition = lmin > 0.0 ? lmax / lmin : std::numeric_limits<double>::infinity();
+    return false;
+  }
+  condition = lmax / lmin;
+  return true;
+}
+
+/**
  * Solves M Y = B for the symmetric positive semi-definite moment matrix M (overwritten), see the file
  * comment. Returns false when M is degenerate (Y untouched). `condition` receives kappa(S M S): exact when
  * exactCondition is set or the robust path ran, else the LDLT pivot ratio (a lower bound).
@@ -80,22 +132,9 @@ bool SolveMoment(Eigen::Matrix<double, Q, Q>& M, const MatB& B, MatY& Y, bool ex
 {
   using Vector = Eigen::Matrix<double, Q, 1>;
   Vector s;
-  const double m00 = M(0, 0);
-  if (!(m00 > 0.0) || !std::isfinite(m00))
+  if (!EquilibrationScales<Q>([&M](int i) { return M(i, i); }, s.data(), condition))
   {
-    condition = std::numeric_limits<double>::infinity();
     return false;
-  }
-  for (int i = 0; i < Q; ++i)
-  {
-    const double d = M(i, i);
-    // A monomial that (numerically) vanishes on every neighbour: the points lie on its zero set.
-    if (!(d > 1e-28 * m00))
-    {
-      condition = std::numeric_limits<double>::infinity();
-      return false;
-    }
-    s(i) = 1.0 / std::sqrt(d);
   }
   M = s.asDiagonal() * M * s.asDiagonal();
   if (!exactCondition)
@@ -114,21 +153,12 @@ bool SolveMoment(Eigen::Matrix<double, Q, Q>& M, const MatB& B, MatY& Y, bool ex
       }
     }
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Q, Q>> eig(M);
-  if (eig.info() != Eigen::Success)
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Q, Q>> eig;
+  if (!RobustDecomposition<Q>(M, eig, condition))
   {
-    condition = std::numeric_limits<double>::infinity();
     return false;
   }
-  const Vector lambda = eig.eigenvalues(); // ascending
-  const double lmax = lambda(Q - 1);
-  const double lmin = lambda(0);
-  if (!(lmin > 0.0) || !(lmax < kMaxCondition * lmin))
-  {
-    condition = lmin > 0.0 ? lmax / lmin : std::numeric_limits<double>::infinity();
-    return false;
-  }
-  condition = lmax / lmin;
+  const Vector lambda = eig.eigenvalues();
   const auto& V = eig.eigenvectors();
   Y = s.asDiagonal() * (V * (lambda.cwiseInverse().asDiagonal() * (V.transpose() * (s.asDiagonal() * B))));
   return true;
@@ -145,21 +175,9 @@ template <int Q>
 bool SolveMomentIdentity(double* M, int r, bool exactCondition, double* Y, double& condition)
 {
   double s[Q];
-  const double m00 = M[0];
-  if (!(m00 > 0.0) || !std::isfinite(m00))
+  if (!EquilibrationScales<Q>([M](int i) { return M[i * Q + i]; }, s, condition))
   {
-    condition = std::numeric_limits<double>::infinity();
     return false;
-  }
-  for (int i = 0; i < Q; ++i)
-  {
-    const double d = M[i * Q + i];
-    if (!(d > 1e-28 * m00))
-    {
-      condition = std::numeric_limits<double>::infinity();
-      return false;
-    }
-    s[i] = 1.0 / std::sqrt(d);
   }
   for (int i = 0; i < Q; ++i)
   {
@@ -235,21 +253,12 @@ bool SolveMomentIdentity(double* M, int r, bool exactCondition, double* Y, doubl
     }
   }
   Eigen::Matrix<double, Q, Q> m = Eigen::Map<const Eigen::Matrix<double, Q, Q, Eigen::RowMajor>>(M);
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Q, Q>> eig(m);
-  if (eig.info() != Eigen::Success)
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Q, Q>> eig;
+  if (!RobustDecomposition<Q>(m, eig, condition))
   {
-    condition = std::numeric_limits<double>::infinity();
     return false;
   }
-  const auto& lambda = eig.eigenvalues(); // ascending
-  const double lmax = lambda(Q - 1);
-  const double lmin = lambda(0);
-  if (!(lmin > 0.0) || !(lmax < kMaxCondition * lmin))
-  {
-    condition = lmin > 0.0 ? lmax / lmin : std::numeric_limits<double>::infinity();
-    return false;
-  }
-  condition = lmax / lmin;
+  const auto& lambda = eig.eigenvalues();
   const auto& V = eig.eigenvectors();
   for (int c = 0; c < r; ++c)
   {
