@@ -80,16 +80,6 @@ bool IsPackedColor(const meshfree::pcd::Field& f)
 }
 } // namespace
 
-vtkMeshFreePCDReader::vtkMeshFreePCDReader()
-{
-  this->SetNumberOfInputPorts(0);
-}
-
-vtkMeshFreePCDReader::~vtkMeshFreePCDReader()
-{
-  this->SetFileName(nullptr);
-}
-
 int vtkMeshFreePCDReader::CanReadFile(const char* filename)
 {
   std::string start;
@@ -103,11 +93,9 @@ int vtkMeshFreePCDReader::CanReadFile(const char* filename)
 int vtkMeshFreePCDReader::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
-  output->Initialize();
-  if (!this->FileName || !*this->FileName)
+  vtkPolyData* output = this->PrepareOutput(outputVector);
+  if (!output)
   {
-    vtkErrorMacro("No FileName given.");
     return 1;
   }
   namespace pcd = meshfree::pcd;
@@ -245,11 +233,4 @@ int vtkMeshFreePCDReader::RequestData(
     output->Initialize();
   }
   return 1;
-}
-
-void vtkMeshFreePCDReader::PrintSelf(ostream& os, vtkIndent indent)
-{
-  this->Superclass::PrintSelf(os, indent);
-  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
-  os << indent << "KeepInvalidPoints: " << (this->KeepInvalidPoints ? "On" : "Off") << "\n";
 }

@@ -22,39 +22,22 @@
 #define vtkMeshFreePCDReader_h
 
 #include "MeshFreeReadersModule.h"
-#include "vtkPolyDataAlgorithm.h"
+#include "vtkMeshFreePointCloudReader.h"
 
-class MESHFREEREADERS_EXPORT vtkMeshFreePCDReader : public vtkPolyDataAlgorithm
+class MESHFREEREADERS_EXPORT vtkMeshFreePCDReader : public vtkMeshFreePointCloudReader
 {
 public:
   static vtkMeshFreePCDReader* New();
-  vtkTypeMacro(vtkMeshFreePCDReader, vtkPolyDataAlgorithm);
-  void PrintSelf(ostream& os, vtkIndent indent) override;
-
-  ///@{
-  /** The .pcd file to read. */
-  vtkSetStringMacro(FileName);
-  vtkGetStringMacro(FileName);
-  ///@}
-
-  ///@{
-  /** Keep the points whose coordinates are NaN (PCL's invalid points) instead of dropping them. Default off. */
-  vtkSetMacro(KeepInvalidPoints, bool);
-  vtkGetMacro(KeepInvalidPoints, bool);
-  vtkBooleanMacro(KeepInvalidPoints, bool);
-  ///@}
+  vtkTypeMacro(vtkMeshFreePCDReader, vtkMeshFreePointCloudReader);
 
   /** 1 when the file starts with a valid .pcd header, 0 otherwise (reads the first 64 KB only). */
   int CanReadFile(const char* filename);
 
 protected:
-  vtkMeshFreePCDReader();
-  ~vtkMeshFreePCDReader() override;
+  vtkMeshFreePCDReader() = default;
+  ~vtkMeshFreePCDReader() override = default;
 
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
-
-  char* FileName = nullptr;
-  bool KeepInvalidPoints = false;
 
 private:
   vtkMeshFreePCDReader(const vtkMeshFreePCDReader&) = delete;

@@ -36,16 +36,6 @@ bool EndsWith(const std::string& s, const std::string& tail)
 }
 } // namespace
 
-vtkMeshFreeXYZReader::vtkMeshFreeXYZReader()
-{
-  this->SetNumberOfInputPorts(0);
-}
-
-vtkMeshFreeXYZReader::~vtkMeshFreeXYZReader()
-{
-  this->SetFileName(nullptr);
-}
-
 int vtkMeshFreeXYZReader::CanReadFile(const char* filename)
 {
   std::string start;
@@ -64,11 +54,9 @@ int vtkMeshFreeXYZReader::CanReadFile(const char* filename)
 int vtkMeshFreeXYZReader::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
-  output->Initialize();
-  if (!this->FileName || !*this->FileName)
+  vtkPolyData* output = this->PrepareOutput(outputVector);
+  if (!output)
   {
-    vtkErrorMacro("No FileName given.");
     return 1;
   }
   meshfree::pcd::MappedFile file;
@@ -195,11 +183,4 @@ int vtkMeshFreeXYZReader::RequestData(
     output->Initialize();
   }
   return 1;
-}
-
-void vtkMeshFreeXYZReader::PrintSelf(ostream& os, vtkIndent indent)
-{
-  this->Superclass::PrintSelf(os, indent);
-  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
-  os << indent << "KeepInvalidPoints: " << (this->KeepInvalidPoints ? "On" : "Off") << "\n";
 }

@@ -20,39 +20,22 @@
 #define vtkMeshFreeXYZReader_h
 
 #include "MeshFreeReadersModule.h"
-#include "vtkPolyDataAlgorithm.h"
+#include "vtkMeshFreePointCloudReader.h"
 
-class MESHFREEREADERS_EXPORT vtkMeshFreeXYZReader : public vtkPolyDataAlgorithm
+class MESHFREEREADERS_EXPORT vtkMeshFreeXYZReader : public vtkMeshFreePointCloudReader
 {
 public:
   static vtkMeshFreeXYZReader* New();
-  vtkTypeMacro(vtkMeshFreeXYZReader, vtkPolyDataAlgorithm);
-  void PrintSelf(ostream& os, vtkIndent indent) override;
-
-  ///@{
-  /** The .xyz / .pts file to read. */
-  vtkSetStringMacro(FileName);
-  vtkGetStringMacro(FileName);
-  ///@}
-
-  ///@{
-  /** Keep the rows whose coordinates are NaN instead of dropping them. Default off. */
-  vtkSetMacro(KeepInvalidPoints, bool);
-  vtkGetMacro(KeepInvalidPoints, bool);
-  vtkBooleanMacro(KeepInvalidPoints, bool);
-  ///@}
+  vtkTypeMacro(vtkMeshFreeXYZReader, vtkMeshFreePointCloudReader);
 
   /** 1 when the first 64 KB of the file read as a text point cloud, 0 otherwise. */
   int CanReadFile(const char* filename);
 
 protected:
-  vtkMeshFreeXYZReader();
-  ~vtkMeshFreeXYZReader() override;
+  vtkMeshFreeXYZReader() = default;
+  ~vtkMeshFreeXYZReader() override = default;
 
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
-
-  char* FileName = nullptr;
-  bool KeepInvalidPoints = false;
 
 private:
   vtkMeshFreeXYZReader(const vtkMeshFreeXYZReader&) = delete;
