@@ -57,26 +57,6 @@ int vtkMeshFreeDeformableSolid::FillInputPortInformation(int, vtkInformation* in
 
 namespace
 {
-// 0, OutputInterval, 2 OutputInterval, ..., and EndTime itself when it is not a multiple.
-std::vector<double> OutputTimes(double endTime, double interval)
-{
-  std::vector<double> times{ 0.0 };
-  if (!(endTime > 0.0) || !(interval > 0.0) || !std::isfinite(endTime) || !std::isfinite(interval))
-  {
-    return times;
-  }
-  const long count = std::min(1000000L, static_cast<long>(std::floor(endTime / interval + 1e-9)));
-  for (long k = 1; k <= count; ++k)
-  {
-    times.push_back(k * interval);
-  }
-  if (endTime - times.back() > 1e-9 * endTime && times.size() < 1000001)
-  {
-    times.push_back(endTime);
-  }
-  return times;
-}
-
 bool Finite(const std::vector<double>& values)
 {
   for (double v : values)
@@ -104,7 +84,7 @@ int vtkMeshFreeDeformableSolid::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  const std::vector<double> times = OutputTimes(this->EndTime, this->OutputInterval);
+  const std::vector<double> times = meshfree::OutputTimes(this->EndTime, this->OutputInterval);
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
   const double range[2] = { times.front(), times.back() };
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
@@ -365,7 +345,7 @@ int vtkMeshFreeDeformableSolid::RequestData(
   this->SimulatedSteps = 0;
 
   // The requested output step: the reported time nearest to the requested one.
-  const std::vector<double> times = OutputTimes(this->EndTime, this->OutputInterval);
+  const std::vector<double> times = meshfree::OutputTimes(this->EndTime, this->OutputInterval);
   long step = 0;
   if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
   {

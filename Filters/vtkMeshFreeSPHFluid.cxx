@@ -52,22 +52,6 @@ int vtkMeshFreeSPHFluid::FillInputPortInformation(int, vtkInformation* info)
 
 namespace
 {
-// Output times 0, interval, ..., end (the last one is `end` itself when it is not a multiple).
-std::vector<double> OutputTimes(double end, double interval)
-{
-  std::vector<double> times{ 0.0 };
-  if (!(interval > 0.0) || !(end > 0.0) || !std::isfinite(end) || !std::isfinite(interval))
-  {
-    return times;
-  }
-  const double count = std::min(std::ceil(end / interval - 1e-9), 1e6);
-  for (long k = 1; k <= static_cast<long>(count); ++k)
-  {
-    times.push_back(std::min(k * interval, end));
-  }
-  return times;
-}
-
 // Triangles of the polygons and strips of `surface`, 9 doubles each (fan triangulation of polygons).
 // Triangles with a NaN or infinite vertex are left out and counted in `skipped`.
 std::vector<double> Triangles(vtkPolyData* surface, long& skipped)
@@ -127,7 +111,7 @@ bool vtkMeshFreeSPHFluid::ValidTimes() const
 
 int vtkMeshFreeSPHFluid::GetNumberOfOutputTimes()
 {
-  return static_cast<int>(OutputTimes(this->EndTime, this->OutputInterval).size());
+  return static_cast<int>(meshfree::OutputTimes(this->EndTime, this->OutputInterval).size());
 }
 
 int vtkMeshFreeSPHFluid::RequestInformation(
@@ -138,7 +122,7 @@ int vtkMeshFreeSPHFluid::RequestInformation(
     vtkErrorMacro("OutputInterval must be finite and > 0, and EndTime finite and >= 0 (got "
       << this->OutputInterval << ", " << this->EndTime << "); the output is empty");
   }
-  this->Impl->Times = OutputTimes(this->EndTime, this->OutputInterval);
+  this->Impl->Times = meshfree::OutputTimes(this->EndTime, this->OutputInterval);
   const std::vector<double>& times = this->Impl->Times;
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
@@ -159,7 +143,7 @@ int vtkMeshFreeSPHFluid::RequestData(
   }
   if (impl.Times.empty())
   {
-    impl.Times = OutputTimes(this->EndTime, this->OutputInterval);
+    impl.Times = meshfree::OutputTimes(this->EndTime, this->OutputInterval);
   }
 
   // Snap the requested time to the nearest output time.

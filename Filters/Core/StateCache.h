@@ -9,11 +9,14 @@
 #ifndef meshfree_StateCache_h
 #define meshfree_StateCache_h
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <iterator>
 #include <limits>
 #include <map>
 #include <utility>
+#include <vector>
 
 namespace meshfree
 {
@@ -88,6 +91,24 @@ private:
   std::size_t Capacity;
   std::map<long, State> States;
 };
+
+/// The output times of a time-dependent source: 0, interval, 2 interval, ..., and `end` itself as the last one
+/// when it is not a multiple (within 1e-9 of an interval); at most 10^6 steps. Just {0} when end or interval
+/// is not positive and finite.
+inline std::vector<double> OutputTimes(double end, double interval)
+{
+  std::vector<double> times{ 0.0 };
+  if (!(interval > 0.0) || !(end > 0.0) || !std::isfinite(end) || !std::isfinite(interval))
+  {
+    return times;
+  }
+  const double count = std::min(std::ceil(end / interval - 1e-9), 1e6);
+  for (long k = 1; k <= static_cast<long>(count); ++k)
+  {
+    times.push_back(std::min(k * interval, end));
+  }
+  return times;
+}
 
 } // namespace meshfree
 

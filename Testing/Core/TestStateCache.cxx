@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <vector>
 
 using meshfree::StateCache;
@@ -49,4 +50,22 @@ TEST(StateCache, BoundedAndKeepsFirstAndLast)
   cache.Clear();
   EXPECT_EQ(cache.Size(), 0u);
   EXPECT_EQ(cache.FindAtOrBefore(19, found), nullptr);
+}
+
+TEST(StateCache, OutputTimesEndWithEndTime)
+{
+  const std::vector<double> t = meshfree::OutputTimes(1.0, 0.3);
+  ASSERT_EQ(t.size(), 5u);
+  EXPECT_EQ(t.front(), 0.0);
+  EXPECT_DOUBLE_EQ(t[3], 0.9);
+  EXPECT_EQ(t.back(), 1.0); // not a multiple of the interval: EndTime itself is the last output time
+  const std::vector<double> exact = meshfree::OutputTimes(0.9, 0.3);
+  ASSERT_EQ(exact.size(), 4u); // 0.9 / 0.3 is 3 up to rounding: no extra step of ~1e-16 at the end
+  EXPECT_NEAR(exact.back(), 0.9, 1e-15);
+  for (double bad : { 0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity() })
+  {
+    EXPECT_EQ(meshfree::OutputTimes(bad, 0.1).size(), 1u);
+    EXPECT_EQ(meshfree::OutputTimes(1.0, bad).size(), 1u);
+  }
+  EXPECT_EQ(meshfree::OutputTimes(1e9, 1e-3).size(), 1000001u); // capped at 10^6 steps
 }
