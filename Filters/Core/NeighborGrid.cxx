@@ -187,8 +187,9 @@ void RadixSort(std::uint64_t*& v, std::uint64_t*& scratch, Index m, int lowBit, 
 // ------------------------------------------------------------------------------ distance filters
 // Filter(): for the sorted positions s in the given ranges, writes (squared distance to x, s) of the points
 // with squared distance <= cut to dist2[] and pos[], and returns their number. The outputs need room for
-// the ranges' total size + 8 entries. Distances are (dx * dx + dy * dy) + dz * dz in IEEE double
-// precision, never fused into FMAs, in every variant: results are bit-identical whichever one runs.
+// the ranges' total size + 8 entries; dist2 may be null (positions only). Distances are (dx * dx + dy * dy)
+// + dz * dz in IEEE double precision, never fused into FMAs, in every variant: results are bit-identical
+// whichever one runs.
 using CellRange = NeighborGrid::CellRange;
 
 int FilterScalar(const double* xyz, const CellRange* ranges, int rangeCount, const double x[3], double cut,
@@ -202,7 +203,10 @@ int FilterScalar(const double* xyz, const CellRange* ranges, int rangeCount, con
       const double* p = xyz + 3 * s;
       const double dx = p[0] - x[0], dy = p[1] - x[1], dz = p[2] - x[2];
       const double d2 = dx * dx + dy * dy + dz * dz;
-      dist2[count] = d2;
+      if (dist2 != nullptr)
+      {
+        dist2[count] = d2;
+      }
       pos[count] = s;
       count += d2 <= cut ? 1 : 0;
     }
@@ -247,7 +251,10 @@ __attribute__((target("avx512f"))) int FilterAvx512(const double* xyz, const Cel
                                          _mm512_maskz_mul_round_pd(all, dy, dy, Round)),
         _mm512_maskz_mul_round_pd(all, dz, dz, Round));
       const __mmask8 keep = _mm512_mask_cmp_pd_mask(lanes(end - s), d2, limit, _CMP_LE_OQ);
-      _mm512_storeu_pd(dist2 + count, _mm512_maskz_compress_pd(keep, d2));
+      if (dist2 != nullptr)
+      {
+        _mm512_storeu_pd(dist2 + count, _mm512_maskz_compress_pd(keep, d2));
+      }
       const __m512i positions = _mm512_add_epi64(_mm512_set1_epi64(s), step);
       _mm512_storeu_si512(pos + count, _mm512_maskz_compress_epi64(keep, positions));
       count += __builtin_popcount(keep);
@@ -1263,14 +1270,17 @@ bool NeighborGrid::FindWithinRadiusForAllPoints(
 {
   const Index n = this->NumberOfInputPoints;
   offsets.assign(static_cast<std::size_t>(n) + 1, 0);
-  ids.clear();
+  // ids keeps its size until the end: resized then, only its growth is zero-filled (it is called every step of
+  // a simulation, with lists of about the same length).
   const Index valid = static_cast<Index>(this->Order.size());
   if (n >= (Index(1) << 31))
   {
+    ids.clear();
     return false;
   }
   if (valid == 0 || !(radius >= 0.0) || !std::isfinite(radius))
   {
+    ids.clear();
     return true;
   }
   const double r2 = radius * radius;
@@ -1296,7 +1306,6 @@ bool NeighborGrid::FindWithinRadiusForAllPoints(
     std::size_t used = 0; // out.size() is the capacity in use; rows are written branch-free past `used`
     // Candidate cells of the current cell (neighbouring ranges merged), and the filter's outputs.
     thread_local std::vector<CellRange> ranges;
-    thread_local detail::Buffer<double> dist2;
     thread_local detail::Buffer<Index> pos;
 #pragma omp for schedule(dynamic, 64)
     for (Index c = 0; c < cellCount; ++c)
@@ -1362,16 +1371,15 @@ bool NeighborGrid::FindWithinRadiusForAllPoints(
           }
         }
       }
-      if (static_cast<Index>(dist2.size()) < total + 8)
+      if (static_cast<Index>(pos.size()) < total + 8)
       {
-        dist2.resize(static_cast<std::size_t>(2 * total + 8));
         pos.resize(static_cast<std::size_t>(2 * total + 8));
       }
       for (Index p = own.Begin; p < own.End; ++p)
       {
         const int found = ranges.empty()
           ? 0
-          : Filter(xyz, ranges.data(), static_cast<int>(ranges.size()), xyz + 3 * p, r2, dist2.data(), pos.data());
+          : Filter(xyz, ranges.data(), static_cast<int>(ranges.size()), xyz + 3 * p, r2, nullptr, pos.data());
         if (out.size() < used + static_cast<std::size_t>(found))
         {
           out.resize(2 * (used + static_cast<std::size_t>(found)));

@@ -32,9 +32,16 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
     this->BoundaryNeighbors.clear();
     return;
   }
+  // Wall dummies: a radius query per particle near a wall. The particles near a wall are not spread evenly
+  // over the (Morton) order, so the work is handed out dynamically; each thread appends its rows to its own
+  // buffer, and the rows are then copied into place in particle order (the lists do not depend on the schedule).
   const int threads = omp_get_max_threads();
   this->ThreadBoundary.resize(threads);
-  std::vector<Index> firstOfThread(threads, n);
+  this->BoundaryRowStart.resize(n);
+  this->BoundaryRowThread.resize(n);
+  Index* rowStart = this->BoundaryRowStart.data();
+  std::int32_t* rowThread = this->BoundaryRowThread.data();
+  Index* counts = this->BoundaryStart.data() + 1;
 #pragma omp parallel if (n >= ParallelThreshold)
   {
     const int t = omp_get_thread_num();
@@ -42,23 +49,19 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
     wall.clear();
     std::vector<Index> ids;
     ids.reserve(256);
-    // Static schedule: each thread handles one contiguous, increasing block of particles, so its lists are
-    // the global lists of that block, in order.
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, 512)
     for (Index i = 0; i < n; ++i)
     {
-      if (firstOfThread[t] == n)
-      {
-        firstOfThread[t] = i;
-      }
       if (this->NearBoundary(x + 3 * i))
       {
         this->BoundaryGrid.FindWithinRadius(x + 3 * i, this->H, ids);
+        rowStart[i] = static_cast<Index>(wall.size());
+        rowThread[i] = t;
         for (Index b : ids)
         {
           wall.push_back(static_cast<std::int32_t>(b));
         }
-        this->BoundaryStart[i + 1] = static_cast<Index>(ids.size());
+        counts[i] = static_cast<Index>(ids.size());
       }
     }
   }
@@ -67,13 +70,15 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
     this->BoundaryStart[i + 1] += this->BoundaryStart[i];
   }
   this->BoundaryNeighbors.resize(this->BoundaryStart[n]);
-#pragma omp parallel if (n >= ParallelThreshold)
+  const Index* start = this->BoundaryStart.data();
+  std::int32_t* rows = this->BoundaryNeighbors.data();
+#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
+  for (Index i = 0; i < n; ++i)
   {
-    const int t = omp_get_thread_num();
-    if (firstOfThread[t] < n)
+    if (start[i + 1] > start[i])
     {
-      std::copy(this->ThreadBoundary[t].begin(), this->ThreadBoundary[t].end(),
-        this->BoundaryNeighbors.begin() + this->BoundaryStart[firstOfThread[t]]);
+      const std::int32_t* from = this->ThreadBoundary[rowThread[i]].data() + rowStart[i];
+      std::copy(from, from + (start[i + 1] - start[i]), rows + start[i]);
     }
   }
 }
@@ -101,6 +106,11 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   const Index* bs = this->BoundaryStart.data();
   const std::int32_t* fn = this->FluidNeighbors.data();
   const std::int32_t* bn = this->BoundaryNeighbors.data();
+  // Per particle, so that the pair loops below multiply instead of divide: p / rho^2 and 1 / rho.
+  this->PressureTerm.resize(n);
+  this->InverseDensity.resize(n);
+  double* pressureTerm = this->PressureTerm.data();
+  double* inverseDensity = this->InverseDensity.data();
 
   // Density (5.32) and pressure (5.40 / Tait).
 #pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
@@ -130,6 +140,8 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
     }
     rho[i] = densityNorm * m * fluidSum;
     pressure[i] = this->PressureOf(rho[i]);
+    pressureTerm[i] = pressure[i] / (rho[i] * rho[i]);
+    inverseDensity[i] = 1.0 / rho[i];
   }
 
   // Pressure of the dummies next to the fluid, extrapolated from their fluid neighbours with the hydrostatic
@@ -190,13 +202,14 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   const double hs = 0.5 * h;
   const double avFactor = p.ArtificialViscosity * this->C0 * hs, avEps = 0.01 * hs * hs;
   const bool artificial = avFactor > 0.0;
+  const double pressureFactor = m * gradientNorm, viscousFactor = mu * m * visc;
 #pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
   for (Index i = 0; i < n; ++i)
   {
     const double* xi = x + 3 * i;
     const double* vi = v + 3 * i;
-    const double rhoI = rho[i];
-    const double termI = pressure[i] / (rhoI * rhoI);
+    const double rhoI = rho[i], inverseI = inverseDensity[i];
+    const double termI = pressureTerm[i];
     double ap[3] = { 0.0, 0.0, 0.0 }, av[3] = { 0.0, 0.0, 0.0 }, normal[3] = { 0.0, 0.0, 0.0 };
     double colourLaplacian = 0.0;
     for (Index s = fs[i]; s < fs[i + 1]; ++s)
@@ -210,25 +223,24 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
         continue;
       }
       const double dist = std::sqrt(r2);
-      const double rhoJ = rho[j];
       if (dist > 0.0)
       {
         // -m (p_i/rho_i^2 + p_j/rho_j^2) grad W, grad W = -gradientNorm shape(r) r
-        double pair = termI + pressure[j] / (rhoJ * rhoJ);
+        double pair = termI + pressureTerm[j];
         if (artificial)
         {
           const double* vj = v + 3 * j;
           const double vr = (vi[0] - vj[0]) * r[0] + (vi[1] - vj[1]) * r[1] + (vi[2] - vj[2]) * r[2];
-          pair += vr < 0.0 ? -avFactor * vr / (0.5 * (rhoI + rhoJ) * (r2 + avEps)) : 0.0;
+          pair += vr < 0.0 ? -avFactor * vr / (0.5 * (rhoI + rho[j]) * (r2 + avEps)) : 0.0;
         }
-        const double coefficient = m * pair * gradientNorm * this->GradientShape(r2, dist);
+        const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
         ap[0] += coefficient * r[0];
         ap[1] += coefficient * r[1];
         ap[2] += coefficient * r[2];
       }
       if (viscous)
       {
-        const double coefficient = mu * m * visc * (h - dist) / (rhoI * rhoJ);
+        const double coefficient = viscousFactor * (h - dist) * inverseI * inverseDensity[j];
         const double* vj = v + 3 * j;
         av[0] += coefficient * (vj[0] - vi[0]);
         av[1] += coefficient * (vj[1] - vi[1]);
@@ -237,7 +249,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
       if (tension)
       {
         const double q = h2 - r2;
-        const double volume = m / rhoJ;
+        const double volume = m * inverseDensity[j];
         const double gradient = -6.0 * poly6 * q * q; // grad W_poly6 = gradient * r
         normal[0] += volume * gradient * r[0];
         normal[1] += volume * gradient * r[1];
@@ -263,7 +275,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
         // No artificial viscosity against the wall: with a particle sliding along it, the dummies ahead are
         // approached and those behind are not, so the term would act as wall friction (free slip wanted).
         const double pair = termI + pb[b] / (rhoB * rhoB);
-        const double coefficient = m * pair * gradientNorm * this->GradientShape(r2, dist);
+        const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
         ap[0] += coefficient * r[0];
         ap[1] += coefficient * r[1];
         ap[2] += coefficient * r[2];
@@ -289,7 +301,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
       const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
       if (length * h > SurfaceThreshold)
       {
-        const double factor = -sigma * colourLaplacian / (length * rhoI);
+        const double factor = -sigma * colourLaplacian * inverseI / length;
         ai[0] += factor * normal[0];
         ai[1] += factor * normal[1];
         ai[2] += factor * normal[2];

@@ -257,6 +257,9 @@ private:
   std::vector<Index> FluidStart, BoundaryStart;
   std::vector<std::int32_t> FluidNeighbors, BoundaryNeighbors;
   std::vector<std::vector<std::int32_t>> ThreadBoundary;
+  std::vector<Index> BoundaryRowStart;           // where particle i's wall row lies in its thread's buffer
+  std::vector<std::int32_t> BoundaryRowThread;   // and which thread's
+  std::vector<double> PressureTerm, InverseDensity; // p / rho^2 and 1 / rho of each particle
 };
 
 } // namespace meshfree
