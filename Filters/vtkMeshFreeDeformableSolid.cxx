@@ -344,24 +344,21 @@ int vtkMeshFreeDeformableSolid::RequestData(
   }
   this->SimulatedSteps = 0;
 
-  // The requested output step: the reported time nearest to the requested one.
+  // The requested time: a reported time (checkpointed), or a time between two of them, simulated from the
+  // reported time before it and not checkpointed (meshfree::PlaceRequestedTime).
   const std::vector<double> times = meshfree::OutputTimes(this->EndTime, this->OutputInterval);
   long step = 0;
-  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
-  {
-    const double t = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
-    const auto it = std::lower_bound(times.begin(), times.end(), t);
-    step = static_cast<long>(it - times.begin());
-    if (step >= static_cast<long>(times.size()) || (step > 0 && t - times[step - 1] < times[step] - t))
-    {
-      --step;
-    }
-  }
+  const double target = meshfree::PlaceRequestedTime(times,
+    outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+      ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+      : 0.0,
+    step);
+  const bool between = target != times[step];
   output->SetNumberOfBlocks(impl.SurfacePoints.empty() ? 1 : 2);
   vtkNew<vtkPolyData> phyxels;
   output->SetBlock(0, phyxels);
   output->GetMetaData(0u)->Set(vtkCompositeDataSet::NAME(), "Phyxels");
-  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), times[step]);
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), target);
   if (!impl.Valid)
   {
     return 1; // the error was reported by BuildModel; an empty "Phyxels" block is the defined result
@@ -382,37 +379,46 @@ int vtkMeshFreeDeformableSolid::RequestData(
   {
     maxStep = 20.0 * impl.Solid.StableTimeStep();
   }
-  const long total = step - found;
+  const long last = between ? step + 1 : step; // s = step + 1 stands for the partial interval
+  const long total = last - found;
   const long unconvergedBefore = impl.Solid.UnconvergedCGSteps();
   const long stepsBefore = impl.Solid.StepsTaken();
-  for (long s = found + 1; s <= step; ++s)
+  for (long s = found + 1; s <= last; ++s)
   {
+    const bool partial = s > step;
+    const double from = times[s - 1], to = partial ? target : times[s];
     bool aborted = false;
     auto abort = [this, &aborted]() { return aborted = (this->GetAbortExecute() != 0); };
     const meshfree::ElasticState previous = impl.Solid.State();
     if (!impl.Unstable)
     {
-      impl.Solid.Advance(times[s] - times[s - 1], maxStep, implicit, abort);
+      impl.Solid.Advance(to - from, maxStep, implicit, abort);
     }
     if (aborted)
     {
       impl.Solid.State() = previous;
-      output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), times[s - 1]);
+      output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), from);
       break;
     }
     if (impl.Unstable || !Finite(impl.Solid.State().Position) || !Finite(impl.Solid.State().Velocity))
     {
       if (!impl.Unstable)
       {
-        vtkErrorMacro("The simulation became unstable between t = " << times[s - 1] << " and " << times[s]
+        vtkErrorMacro("The simulation became unstable between t = " << from << " and " << to
                                                                     << " s; later times repeat the last finite "
                                                                        "state. Reduce TimeStep or stiffness.");
       }
-      impl.Unstable = true;
+      if (!partial) // a partial interval is not checkpointed, so it does not mark the later times
+      {
+        impl.Unstable = true;
+      }
       impl.Solid.State() = previous;
     }
-    impl.Solid.State().Time = times[s];
-    impl.Cache.Insert(s, impl.Solid.State());
+    impl.Solid.State().Time = to;
+    if (!partial)
+    {
+      impl.Cache.Insert(s, impl.Solid.State());
+    }
     ++this->SimulatedSteps;
     this->UpdateProgress(static_cast<double>(s - found) / static_cast<double>(std::max(1L, total)));
   }

@@ -13,9 +13,11 @@
  * the VTK-free core, meshfree::ElasticSolid (Filters/Core/ElasticSolid.h), which documents the model.
  *
  * Time: the source reports the time steps 0, OutputInterval, 2 OutputInterval, ..., EndTime and returns the
- * state at exactly the reported time nearest to the requested one. States are kept in a bounded cache of
- * checkpoints: revisiting a time costs nothing, and a later time is simulated from the nearest earlier
- * checkpoint. Any property change (or a change of the input) rebuilds the model and clears the cache.
+ * state at exactly the requested time (clamped to [0, EndTime]). The states at reported times are kept in a
+ * bounded cache of checkpoints: revisiting a time costs nothing, and a later time is simulated from the nearest
+ * earlier checkpoint. A time between two reported ones is simulated from the reported time before it and not
+ * checkpointed, so a state never depends on what was requested before. Any property change (or a change of the
+ * input) rebuilds the model and clears the cache.
  *
  * Output: vtkMultiBlockDataSet. Block 0 "Phyxels": vtkPolyData of vertices at the current positions with
  * Displacement, Velocity, Strain and Stress (6 components xx, yy, zz, xy, yz, xz; Green strain and the stress

@@ -146,20 +146,16 @@ int vtkMeshFreeSPHFluid::RequestData(
     impl.Times = meshfree::OutputTimes(this->EndTime, this->OutputInterval);
   }
 
-  // Snap the requested time to the nearest output time.
+  // The requested time: an output time (cached), or a time between two of them, simulated from the output
+  // time before it and not cached (meshfree::PlaceRequestedTime).
   const std::vector<double>& times = impl.Times;
-  double requested = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+  const double requested = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
     ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
     : 0.0;
   long step = 0;
-  for (long k = 1; k < static_cast<long>(times.size()); ++k)
-  {
-    if (std::fabs(times[k] - requested) < std::fabs(times[step] - requested))
-    {
-      step = k;
-    }
-  }
-  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), times[step]);
+  const double target = meshfree::PlaceRequestedTime(times, requested, step);
+  const bool between = target != times[step];
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), target);
 
   meshfree::SPHParameters p;
   p.Dimension = this->Dimension;
@@ -222,20 +218,23 @@ int vtkMeshFreeSPHFluid::RequestData(
     return 1; // empty output, the error has been reported
   }
 
-  // Restore the nearest earlier cached state and simulate forward, caching every output time reached.
+  // Restore the nearest earlier cached state and simulate forward, caching every output time reached; then,
+  // for a time between output times, on to it (not cached).
   long found = 0;
   const meshfree::SPHState* cached = impl.Cache.FindAtOrBefore(step, found);
   meshfree::SPHState state = *cached;
   const long reducedBefore = impl.Solver.ReducedSteps();
-  for (long k = found + 1; k <= step; ++k)
+  const long last = between ? step + 1 : step; // k = step + 1 stands for the partial interval
+  for (long k = found + 1; k <= last; ++k)
   {
     const long stepsBefore = state.Steps;
-    const double span = static_cast<double>(step - found);
+    const double span = static_cast<double>(last - found);
     const auto progress = [this, k, found, span](double fraction) {
       this->UpdateProgress((static_cast<double>(k - found - 1) + fraction) / span);
       return !this->GetAbortExecute();
     };
-    const meshfree::SPHFluid::Status status = impl.Solver.Advance(state, times[k], progress);
+    const bool partial = k > step;
+    const meshfree::SPHFluid::Status status = impl.Solver.Advance(state, partial ? target : times[k], progress);
     this->StepsTaken += state.Steps - stepsBefore;
     if (status == meshfree::SPHFluid::Status::Aborted)
     {
@@ -247,7 +246,10 @@ int vtkMeshFreeSPHFluid::RequestData(
       vtkErrorMacro("SPH Fluid: " << impl.Solver.ErrorMessage() << "; the output is empty");
       return 1;
     }
-    impl.Cache.Insert(k, state);
+    if (!partial)
+    {
+      impl.Cache.Insert(k, state);
+    }
   }
   if (impl.Solver.ReducedSteps() > reducedBefore)
   {

@@ -6,11 +6,13 @@
  * the closed container `DomainBounds` and simulates them with the VTK-free core (meshfree::SPHFluid, see
  * Filters/Core/SPHFluid.h for the model, kernels, walls and time stepping). `Dimension` 2 simulates the x–z plane.
  *
- * Time: the source reports the time steps 0, OutputInterval, …, EndTime; a requested time is snapped to the
- * nearest of them and the output is the state at exactly that time. Simulated states are kept in a bounded
- * cache (`CacheSize` states, meshfree::StateCache): a request restores the nearest earlier cached state and
- * simulates forward from there, so revisiting a time or stepping backwards never restarts from t = 0. Any change
- * of a property that affects the simulation, or of the `Obstacles` input, empties the cache.
+ * Time: the source reports the time steps 0, OutputInterval, …, EndTime, and the output is the state at exactly
+ * the requested time (clamped to [0, EndTime]): the time steps land on it. The states at the reported times are
+ * kept in a bounded cache (`CacheSize` states, meshfree::StateCache): a request restores the nearest earlier
+ * cached state and simulates forward from there, so revisiting a time or stepping backwards never restarts from
+ * t = 0. A time between two reported ones (ParaView's "Sequence" or "Real Time" animation) is simulated from the
+ * reported time before it and not cached, so a state never depends on what was requested before. Any change of
+ * a property that affects the simulation, or of the `Obstacles` input, empties the cache.
  *
  * Optional input port 0, `Obstacles`: closed polygonal surfaces (polygons and triangle strips are triangulated)
  * that the fluid flows around.

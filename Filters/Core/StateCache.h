@@ -1,6 +1,7 @@
 // Bounded cache of simulation states keyed by output-step index, shared by the time-dependent sources.
 //
-// The sources report output times t_k = k * OutputInterval. A request for step k restores the cached state of
+// The sources report output times t_k = k * OutputInterval (OutputTimes() below); a requested time is placed
+// among them by PlaceRequestedTime(). A request for step k restores the cached state of
 // the largest cached step <= k and simulates forward from there, so scrubbing the time slider backwards or
 // revisiting a time never re-simulates from t = 0. The cache holds at most `capacity` states; when full it
 // evicts so that the kept steps stay spread over the timeline (it drops the entry whose removal leaves the
@@ -108,6 +109,33 @@ inline std::vector<double> OutputTimes(double end, double interval)
     times.push_back(std::min(k * interval, end));
   }
   return times;
+}
+
+/// Where a requested time falls among the output times `times` (from OutputTimes()): returns the time to
+/// produce and sets `step` to the last output time at or before it. A request within 1e-9 of an interval of an
+/// output time gets that output time; one before the first or after the last output time (or not finite) gets
+/// the first or the last; any other request gets itself, exactly: the sources then simulate from the output
+/// state `step` (cached) to it, without caching the result, so it does not depend on earlier requests.
+inline double PlaceRequestedTime(const std::vector<double>& times, double requested, long& step)
+{
+  step = 0;
+  if (times.empty())
+  {
+    return 0.0;
+  }
+  const long last = static_cast<long>(times.size()) - 1;
+  const double tolerance = last > 0 ? 1e-9 * (times[1] - times[0]) : 0.0;
+  if (!(requested > times[0] + tolerance)) // also NaN
+  {
+    return times[0];
+  }
+  if (requested >= times[last] - tolerance)
+  {
+    step = last;
+    return times[last];
+  }
+  step = static_cast<long>(std::upper_bound(times.begin(), times.end(), requested + tolerance) - times.begin()) - 1;
+  return requested - times[step] <= tolerance ? times[step] : requested;
 }
 
 } // namespace meshfree

@@ -69,3 +69,33 @@ TEST(StateCache, OutputTimesEndWithEndTime)
   }
   EXPECT_EQ(meshfree::OutputTimes(1e9, 1e-3).size(), 1000001u); // capped at 10^6 steps
 }
+
+TEST(StateCache, RequestedTimesArePlacedAmongTheOutputTimes)
+{
+  const std::vector<double> t = meshfree::OutputTimes(1.0, 0.3); // 0, 0.3, 0.6, 0.9, 1.0
+  long step = -1;
+  EXPECT_EQ(meshfree::PlaceRequestedTime(t, 0.6, step), t[2]); // an output time: itself
+  EXPECT_EQ(step, 2);
+  EXPECT_EQ(meshfree::PlaceRequestedTime(t, t[2] * (1.0 + 1e-12), step), t[2]); // round-off: the output time
+  EXPECT_EQ(step, 2);
+  EXPECT_EQ(meshfree::PlaceRequestedTime(t, t[3] * (1.0 - 1e-12), step), t[3]);
+  EXPECT_EQ(step, 3);
+  EXPECT_EQ(meshfree::PlaceRequestedTime(t, 0.45, step), 0.45); // between: exactly the request, from step 1
+  EXPECT_EQ(step, 1);
+  EXPECT_EQ(meshfree::PlaceRequestedTime(t, 0.95, step), 0.95); // in the short last interval
+  EXPECT_EQ(step, 3);
+  EXPECT_EQ(meshfree::PlaceRequestedTime(t, 0.01, step), 0.01);
+  EXPECT_EQ(step, 0);
+  EXPECT_EQ(meshfree::PlaceRequestedTime(t, 7.0, step), 1.0); // past the end: the last output time
+  EXPECT_EQ(step, 4);
+  for (double outside : { -1.0, std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity() })
+  {
+    EXPECT_EQ(meshfree::PlaceRequestedTime(t, outside, step), 0.0);
+    EXPECT_EQ(step, 0);
+  }
+  EXPECT_EQ(meshfree::PlaceRequestedTime(t, std::numeric_limits<double>::infinity(), step), 1.0);
+  EXPECT_EQ(step, 4);
+  const std::vector<double> single = meshfree::OutputTimes(0.0, 0.1); // just {0}
+  EXPECT_EQ(meshfree::PlaceRequestedTime(single, 0.5, step), 0.0);
+  EXPECT_EQ(step, 0);
+}

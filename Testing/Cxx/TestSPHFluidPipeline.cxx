@@ -102,14 +102,25 @@ int TestSPHFluidPipeline(int, char*[])
   At(fluid, 0.1);
   Check(fluid->GetStepsTaken() == stepsTo10, "revisiting / going back re-uses the cache");
   Check(Snapshot(fluid->GetOutput()) == at10, "revisited state identical");
-  // A requested time between two output times snaps to the nearest.
-  At(fluid, 0.1009);
-  Check(fluid->GetOutput()->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()) == 0.1, "snapped");
+  // A requested time between two output times: the state at exactly that time, simulated from the output time
+  // before it (a few steps), the same whenever it is asked, and not disturbing the cached output states.
+  const auto between = Snapshot(At(fluid, 0.1009));
+  Check(fluid->GetOutput()->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()) == 0.1009, "exactly 0.1009");
+  const long partialSteps = fluid->GetStepsTaken() - stepsTo10;
+  Check(partialSteps > 0 && partialSteps < stepsTo10 / 10, "simulated from t = 0.1 only");
+  Check(between != at10 && between.size() == at10.size(), "a different state, same particles");
+  Check(Snapshot(At(fluid, 0.1)) == at10, "the cached output state is unchanged");
+  Check(Snapshot(At(fluid, 0.1009)) == between, "the same state when asked again");
+  Check(fluid->GetStepsTaken() - stepsTo10 == 2 * partialSteps, "only the partial interval is simulated again");
 
   // Forward from the nearest cached state only.
+  const long stepsBeforeForward = fluid->GetStepsTaken();
   At(fluid, 0.12);
-  const long oneInterval = fluid->GetStepsTaken() - stepsTo10;
+  const long oneInterval = fluid->GetStepsTaken() - stepsBeforeForward;
   Check(oneInterval > 0 && oneInterval < stepsTo10 / 3, "forward from the nearest earlier state");
+  // Past the end: the state at EndTime.
+  At(fluid, 0.2 + 1e-3);
+  Check(fluid->GetOutput()->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()) == 0.2, "clamped to EndTime");
 
   // Determinism: a fresh source asked in another order gives the same bits.
   vtkNew<vtkMeshFreeSPHFluid> other;

@@ -73,10 +73,17 @@ positions_01 = np.array(phyxels(data).Points)
 data, steps = state(solid, 0.3)
 assert steps == 0, steps
 assert np.array_equal(np.array(phyxels(data).Points), positions_03)
-# A requested time between reported steps returns the nearest reported one, exactly.
+# A requested time between reported steps: the state at exactly that time, simulated from the reported time
+# before it (one partial interval, not checkpointed), the same when asked again, the checkpoints undisturbed.
 data, steps = state(solid, 0.099)
-assert abs(data.GetInformation().Get(data.DATA_TIME_STEP()) - 0.1) < 1e-12
-assert np.array_equal(np.array(phyxels(data).Points), positions_01)
+assert abs(data.GetInformation().Get(data.DATA_TIME_STEP()) - 0.099) < 1e-15
+assert steps == 1, steps
+positions_099 = np.array(phyxels(data).Points)
+assert not np.array_equal(positions_099, positions_01)
+data, steps = state(solid, 0.1)
+assert steps == 0 and np.array_equal(np.array(phyxels(data).Points), positions_01), steps
+data, steps = state(solid, 0.099)
+assert steps == 1 and np.array_equal(np.array(phyxels(data).Points), positions_099), steps
 # Going further simulates only the missing intervals.
 data, steps = state(solid, 0.4)
 assert steps == 2, steps
