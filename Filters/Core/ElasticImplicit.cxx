@@ -158,6 +158,10 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
   double* x = this->Current.Position.data();
   double* v = this->Current.Velocity.data();
   this->ComputeInternalForces(x, this->Force);
+  // The scale of the right-hand side M v + dt (f_int + f_other), for the CG stopping test: its terms' norms
+  // added, not the norm of their sum, which vanishes at equilibrium (a hanging body: f_int = -M g, v = 0),
+  // where a test relative to it would ask for ever more digits of a near-zero velocity.
+  std::vector<double> internal(this->Force.begin(), this->Force.begin() + 3 * n);
   this->AddContactForces(x, this->Force);
   this->AddExternalForces(this->Force);
   const std::vector<double> Fs = this->DefGrad; // kept: ApplyHessian reuses the scratch buffers
@@ -253,7 +257,22 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
   filter(sol);
   filter(b);
   apply(sol, Ap);
-  double bnorm = 0.0, rz = 0.0;
+  double momentum2 = 0.0, internal2 = 0.0, other2 = 0.0, rz = 0.0;
+  for (Index i = 0; i < n; ++i)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      const Index c = 3 * i + a;
+      if (!this->IsFixed[i])
+      {
+        const double other = this->Force[c] - internal[c] + this->Mass[i] * g[a];
+        momentum2 += this->Mass[i] * v[c] * this->Mass[i] * v[c];
+        internal2 += internal[c] * internal[c];
+        other2 += other * other;
+      }
+    }
+  }
+  const double bnorm = std::sqrt(momentum2) + dt * (std::sqrt(internal2) + std::sqrt(other2));
   for (Index c = 0; c < 3 * n; ++c)
   {
     r[c] = b[c] - Ap[c];
@@ -264,9 +283,7 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
     z[c] = r[c] / diag[c];
     p[c] = z[c];
     rz += r[c] * z[c];
-    bnorm += b[c] * b[c];
   }
-  bnorm = std::sqrt(bnorm);
   int it = 0;
   double rnorm = 0.0;
   for (; it < maxIterations; ++it)
