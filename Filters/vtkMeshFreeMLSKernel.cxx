@@ -9,6 +9,7 @@
 
 #include "Approximation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -134,7 +135,10 @@ vtkIdType vtkMeshFreeMLSKernel::ComputeBasis(double x[3], vtkIdList* pIds, vtkId
   }
   else
   {
-    grid.FindKNearest(x, this->NeighborCount, st.Ids, st.Dist2);
+    // As the MeshlessApproximation filter: at least kMinimumNeighborsPerTerm neighbours per basis term, or
+    // each fit nearly interpolates and overshoots between points (cubics in 3D with 20 neighbours).
+    const int terms = meshfree::BasisSize(std::max(this->Core->Approx.CloudDimension(), 0), this->BasisDegree);
+    grid.FindKNearest(x, std::max(this->NeighborCount, meshfree::kMinimumNeighborsPerTerm * terms), st.Ids, st.Dist2);
   }
   const int n = static_cast<int>(st.Ids.size());
   if (!this->Core->Approx.ShapeFunctionsFor(x, st.Ids.data(), n, st.Phi, st.Scratch))

@@ -3,8 +3,9 @@
  * @brief   moving-least-squares shape functions as a VTK interpolation kernel
  *
  * Drop-in kernel for vtkPointInterpolator (and vtkPointInterpolator2D): at each probe point, the
- * NeighborCount nearest source points (found with MeshFree's neighbour grid, built in Initialize()), or
- * those within SupportRadius when it is > 0, get the MLS shape functions
+ * NeighborCount nearest source points (found with MeshFree's neighbour grid, built in Initialize(); at least
+ * 2 per basis term, as in the MeshlessApproximation filter), or those within SupportRadius when it is > 0, get
+ * the MLS shape functions
  * phi_j(x) = w_j b(xi_j)^T M^-1 b(0) of a polynomial basis of degree BasisDegree in coordinates shifted to x
  * and scaled by the support h (thesis 2.20, 3.26; see Filters/Core/LocalFit.h). They reproduce polynomials
  * of degree <= BasisDegree exactly, sum to 1 and may be negative; unlike VTK's own kernels they are not

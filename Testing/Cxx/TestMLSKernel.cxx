@@ -9,6 +9,7 @@
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkGaussianKernel.h"
+#include "vtkIdList.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
@@ -105,6 +106,58 @@ int TestMLSKernel(int, char*[])
   {
     std::cerr << "ERROR: kernel and filter disagree\n";
     return EXIT_FAILURE;
+  }
+
+  // Cubics in 3D with the default 20 neighbours: 20 basis terms, so the kernel, like the filter, takes at least
+  // 2 neighbours per term (40) and both give the same values.
+  {
+    vtkNew<vtkPoints> points3;
+    points3->SetDataTypeToDouble();
+    vtkNew<vtkDoubleArray> g;
+    g->SetName("G");
+    for (int i = 0; i < 2000; ++i)
+    {
+      const double x = Halton(i + 1, 2), y = Halton(i + 1, 3), z = Halton(i + 1, 5);
+      points3->InsertNextPoint(x, y, z);
+      g->InsertNextValue(Franke(x, y) * (1.0 + z * z));
+    }
+    vtkNew<vtkPolyData> cloud3;
+    cloud3->SetPoints(points3);
+    cloud3->GetPointData()->AddArray(g);
+    vtkNew<vtkImageData> probe3;
+    probe3->SetDimensions(7, 7, 7);
+    probe3->SetOrigin(0.2, 0.2, 0.2);
+    probe3->SetSpacing(0.1, 0.1, 0.1);
+    vtkNew<vtkMeshFreeMLSKernel> cubic;
+    cubic->SetBasisDegree(3);
+    cubic->Initialize(nullptr, cloud3, cloud3->GetPointData());
+    vtkNew<vtkIdList> ids;
+    double centre[3] = { 0.5, 0.5, 0.5 };
+    const vtkIdType used = cubic->ComputeBasis(centre, ids);
+    std::cout << "cubic 3D kernel: " << used << " neighbours for NeighborCount 20\n";
+    vtkNew<vtkPointInterpolator> interpolator3;
+    interpolator3->SetInputData(probe3);
+    interpolator3->SetSourceData(cloud3);
+    interpolator3->SetKernel(cubic);
+    interpolator3->Update();
+    vtkNew<vtkMeshlessApproximation> filter3;
+    filter3->SetBasisDegree(3);
+    filter3->SetInputData(0, cloud3);
+    filter3->SetInputData(1, probe3);
+    filter3->Update();
+    vtkDataArray* a = vtkDataSet::SafeDownCast(filter3->GetOutputDataObject(0))->GetPointData()->GetArray("G");
+    vtkDataArray* b = interpolator3->GetOutput()->GetPointData()->GetArray("G");
+    double diff3 = 0.0;
+    for (vtkIdType i = 0; a && b && i < a->GetNumberOfTuples(); ++i)
+    {
+      diff3 = std::max(diff3, std::fabs(a->GetTuple1(i) - b->GetTuple1(i)));
+    }
+    std::cout << "cubic 3D: max |kernel - filter| = " << diff3 << "\n";
+    if (used != 40 || !a || !b || !(diff3 < 1e-10))
+    {
+      std::cerr << "ERROR: the cubic 3D kernel does not take 2 neighbours per basis term as the filter does\n";
+      return EXIT_FAILURE;
+    }
   }
 
   // VTK's Gaussian kernel (normalised positive weights) on the same data: first order at best.
