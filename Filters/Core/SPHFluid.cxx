@@ -151,7 +151,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   const Index nb = this->BoundaryCount;
   if (nb > 0)
   {
-    this->BoundaryPressure.assign(nb, 0.0);
+    this->BoundaryPressureTerm.assign(nb, 0.0);
     this->BoundaryActive.assign(nb, 0);
     const Index total = bs[n];
 #pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
@@ -159,7 +159,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
     {
       this->BoundaryActive[bn[s]] = 1; // same value from every thread
     }
-    double* pb = this->BoundaryPressure.data();
+    double* pbTerm = this->BoundaryPressureTerm.data();
     const char* active = this->BoundaryActive.data();
 #pragma omp parallel if (n >= ParallelThreshold)
     {
@@ -187,11 +187,13 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
             sumG += rho[f] * (g[0] * r[0] + g[1] * r[1] + g[2] * r[2]) * w;
           }
         }
-        pb[b] = sumW > 0.0 ? std::max(0.0, (sumP + sumG) / sumW) : 0.0;
+        const double pb = sumW > 0.0 ? std::max(0.0, (sumP + sumG) / sumW) : 0.0;
+        const double rhoB = this->DensityOf(pb);
+        pbTerm[b] = pb / (rhoB * rhoB); // the pair force's p_b / rho_b^2, once per dummy
       }
     }
   }
-  const double* pb = this->BoundaryPressure.data();
+  const double* pbTerm = this->BoundaryPressureTerm.data();
 
   // Forces: pressure (5.37, symmetric), viscosity (5.46), colour-field surface tension, gravity.
   const double mu = p.Viscosity, sigma = p.SurfaceTension;
@@ -212,6 +214,15 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
     const double termI = pressureTerm[i];
     double ap[3] = { 0.0, 0.0, 0.0 }, av[3] = { 0.0, 0.0, 0.0 }, normal[3] = { 0.0, 0.0, 0.0 };
     double colourLaplacian = 0.0;
+    // Colour field c = sum_j V_j W_poly6: grad W = gradient r, lap W = -6 poly6 q (d q - 4 r^2), q = h^2 - r^2.
+    auto addColour = [&](double volume, const double r[3], double r2) {
+      const double q = h2 - r2;
+      const double gradient = -6.0 * poly6 * q * q;
+      normal[0] += volume * gradient * r[0];
+      normal[1] += volume * gradient * r[1];
+      normal[2] += volume * gradient * r[2];
+      colourLaplacian += volume * -6.0 * poly6 * q * (d * q - 4.0 * r2);
+    };
     for (Index s = fs[i]; s < fs[i + 1]; ++s)
     {
       const Index j = fn[s];
@@ -248,13 +259,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
       }
       if (tension)
       {
-        const double q = h2 - r2;
-        const double volume = m * inverseDensity[j];
-        const double gradient = -6.0 * poly6 * q * q; // grad W_poly6 = gradient * r
-        normal[0] += volume * gradient * r[0];
-        normal[1] += volume * gradient * r[1];
-        normal[2] += volume * gradient * r[2];
-        colourLaplacian += volume * -6.0 * poly6 * q * (d * q - 4.0 * r2);
+        addColour(m * inverseDensity[j], r, r2);
       }
     }
     for (Index s = bs[i]; s < bs[i + 1]; ++s)
@@ -270,11 +275,10 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
       const double dist = std::sqrt(r2);
       if (dist > 0.0)
       {
-        // Symmetric pair force with the dummy's extrapolated pressure; its density from the EOS.
-        const double rhoB = this->DensityOf(pb[b]);
+        // Symmetric pair force with the dummy's extrapolated pressure (its density from the EOS).
         // No artificial viscosity against the wall: with a particle sliding along it, the dummies ahead are
         // approached and those behind are not, so the term would act as wall friction (free slip wanted).
-        const double pair = termI + pb[b] / (rhoB * rhoB);
+        const double pair = termI + pbTerm[b];
         const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
         ap[0] += coefficient * r[0];
         ap[1] += coefficient * r[1];
@@ -282,14 +286,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
       }
       if (tension)
       {
-        // Walls count as fluid in the colour field (neutral wetting): no spurious surface along them.
-        const double q = h2 - r2;
-        const double volume = m / p.RestDensity;
-        const double gradient = -6.0 * poly6 * q * q;
-        normal[0] += volume * gradient * r[0];
-        normal[1] += volume * gradient * r[1];
-        normal[2] += volume * gradient * r[2];
-        colourLaplacian += volume * -6.0 * poly6 * q * (d * q - 4.0 * r2);
+        addColour(m / p.RestDensity, r, r2); // walls count as fluid (neutral wetting): no surface along them
       }
     }
     double* ai = acc + 3 * i;

@@ -245,7 +245,7 @@ private:
   // Boundary (dummy) particles, static; obstacle surface samples with outward normals; their grids.
   std::vector<double> BoundaryPosition;
   Index BoundaryCount = 0;
-  std::vector<double> BoundaryPressure; // extrapolated each step, for dummies next to the fluid
+  std::vector<double> BoundaryPressureTerm; // p / rho^2 of the pressure extrapolated each step to the dummies
   std::vector<char> BoundaryActive;
   NeighborGrid BoundaryGrid;
   std::vector<double> ObstaclePosition, ObstacleNormal;
