@@ -15,9 +15,9 @@
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
-#include "ElasticShapes.h"
-#include "ElasticSolid.h"
-#include "StateCache.h"
+#include "Elastic/ElasticShapes.h"
+#include "Elastic/ElasticSolid.h"
+#include "Common/StateCache.h"
 
 #include <algorithm>
 #include <cmath>

@@ -9,7 +9,7 @@
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
-#include "Kernels.h"
+#include "Common/Kernels.h"
 
 #include <cmath>
 #include <stdexcept>

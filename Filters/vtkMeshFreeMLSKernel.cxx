@@ -7,7 +7,7 @@
 #include "vtkPointData.h"
 #include "vtkObjectFactory.h"
 
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <algorithm>
 #include <cmath>

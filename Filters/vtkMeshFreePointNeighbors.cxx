@@ -11,7 +11,7 @@
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 
-#include "NeighborGrid.h"
+#include "Common/NeighborGrid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -13,8 +13,8 @@
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
-#include "SPHFluid.h"
-#include "StateCache.h"
+#include "SPH/SPHFluid.h"
+#include "Common/StateCache.h"
 
 #include <algorithm>
 #include <cmath>

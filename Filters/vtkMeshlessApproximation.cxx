@@ -17,7 +17,7 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStructuredGrid.h"
 
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,7 +2,7 @@
 // neighbours in 2D (Halton cloud of N = 10,000 points, probes on a grid), single thread and all threads.
 // Usage: BenchApproximation [evaluations (default 1,000,000)]
 #include "TestFunctions.h"
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <chrono>
 #include <cmath>

@@ -2,8 +2,8 @@
 // (quadratic and linear gradient fits, with and without self-contact), and the cost and CG iterations of
 // implicit steps. Usage: BenchElasticSolid [lattice edge, default 46 -> 97,336 phyxels] [steps, default 20]
 // The thesis managed 299 phyxels at 7.3 steps/s (about 2,200 phyxel-steps/s, all-pairs neighbour search).
-#include "ElasticShapes.h"
-#include "ElasticSolid.h"
+#include "Elastic/ElasticShapes.h"
+#include "Elastic/ElasticSolid.h"
 
 #include <omp.h>
 

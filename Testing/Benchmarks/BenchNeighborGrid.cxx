@@ -13,7 +13,7 @@
 // on at most 250k of them. Rates are measured with a wall clock around each iteration; the best of all
 // runs of a case is kept, and the ratios MeshFree / VTK and MeshFree / brute force are printed at the end.
 // Run: BenchNeighborGrid --benchmark_repetitions=3
-#include "NeighborGrid.h"
+#include "Common/NeighborGrid.h"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>

@@ -4,8 +4,8 @@
 // Then the time cache as the SPH Fluid source uses it (StateCache, an entry per output time): a 2D dam break
 // (3,200 particles) simulated to 0.2 s with outputs every 0.02 s, then the cost of revisiting a cached time
 // (restoring the state) against simulating forward to it again.
-#include "SPHFluid.h"
-#include "StateCache.h"
+#include "SPH/SPHFluid.h"
+#include "Common/StateCache.h"
 
 #include <chrono>
 #include <cstdio>

@@ -4,7 +4,7 @@
 // <= 2e-5 at N = 10,000; observed convergence order ~ m + 1 for degree m = 0..3 over N = 250 ... 16,000;
 // Renka-Brown's other test functions converge too; the thesis' 9-point example (§3.4).
 #include "TestFunctions.h"
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <gtest/gtest.h>
 

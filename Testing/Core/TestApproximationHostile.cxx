@@ -3,7 +3,7 @@
 // coplanar clouds in 2D and 3D, NaN coordinates or values, NeighborCount larger than the cloud, tiny
 // SupportRadius, probe points far outside, multi-component data. Every method must give a defined output
 // with no NaN/Inf, with masks and the report saying what happened.
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <gtest/gtest.h>
 

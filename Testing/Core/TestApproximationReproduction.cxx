@@ -4,7 +4,7 @@
 // and 1e6, in 2D (flat in z), in 3D and on a tilted plane; gradients of the fits reproduce the
 // polynomials' gradients.
 #include "TestFunctions.h"
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <gtest/gtest.h>
 

@@ -3,8 +3,8 @@
 // note's worked example made slender, L/h = 10 (L = 0.8, h = b = 0.08, rho = 1000, E = 1e4, nu = 0, g = 0.005:
 // delta_tip = 0.048 m = 6 % of L, f1 = 0.064 Hz), 4 phyxels across. At L/h = 5 the same model is ~25 % too
 // flexible: the compliance of the clamp's root region, which the beam formulas ignore, weighs 8x more there.
-#include "ElasticShapes.h"
-#include "ElasticSolid.h"
+#include "Elastic/ElasticShapes.h"
+#include "Elastic/ElasticSolid.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Core tests of the meshless elastic solid's other parts: Lennard-Jones contacts, the implicit integrator,
 // plasticity, the embedded surface and the built-in shapes.
-#include "ElasticShapes.h"
-#include "ElasticSolid.h"
+#include "Elastic/ElasticShapes.h"
+#include "Elastic/ElasticSolid.h"
 
 #include <gtest/gtest.h>
 

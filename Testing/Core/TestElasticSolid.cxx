@@ -1,7 +1,7 @@
 // Core tests of the meshless elastic solid (Mueller 2004): exact oracles (patch test, rigid motion, momentum)
 // and the material constants (uniaxial tension). Formulas: research/elastic.md sec. 1 and 4.
-#include "ElasticShapes.h"
-#include "ElasticSolid.h"
+#include "Elastic/ElasticShapes.h"
+#include "Elastic/ElasticSolid.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // Weight functions (Filters/Core/Kernels.h): normalisation by independent radial quadrature and against the
 // published constants, derivatives against fourth-order Cartesian finite differences, compact support, scale
 // invariance, symmetry, monotonicity, finiteness at r = 0, invalid arguments and names.
-#include "Kernels.h"
+#include "Common/Kernels.h"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // path's pivot ratio is a lower bound of the exact condition number, degenerate neighbourhoods (collinear
 // points for a 2D linear basis, too few points) are refused instead of solved, and fits with many
 // right-hand sides (LS/WLS/PU-WLS) recover polynomial coefficients.
-#include "LocalFit.h"
+#include "Common/LocalFit.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // NeighborGrid against brute force: radius results as exact index sets, k-nearest results as exact
 // (distance, index) lists. The grid breaks distance ties by the original index, so the brute-force
 // reference (the first k of all points sorted by (distance, index)) is unique even with duplicates.
-#include "NeighborGrid.h"
+#include "Common/NeighborGrid.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>

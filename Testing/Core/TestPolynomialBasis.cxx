@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // PolynomialBasis.h: sizes, the ordering (1, linear terms, ...), exponents of every monomial against a
 // brute-force enumeration, and derivatives against central differences.
-#include "PolynomialBasis.h"
+#include "Common/PolynomialBasis.h"
 
 #include <gtest/gtest.h>
 

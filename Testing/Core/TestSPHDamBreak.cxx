@@ -28,7 +28,7 @@
 //    (artificial viscosity against the wall dummies, as DualSPHysics does) and a hydrostatically compressed
 //    initial state;
 //  * the Ritter bound (shallow-water front speed 2 sqrt(g 2a), dZ/dT <= 2), mass conservation and containment.
-#include "SPHFluid.h"
+#include "SPH/SPHFluid.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // SPH fluid core (SPHFluid.h): kernels and lattice consistency, conservation, determinism, hostile settings and
 // the settled hydrostatic column (pressure against rho0 g (H - z)).
-#include "SPHFluid.h"
+#include "SPH/SPHFluid.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "StateCache.h"
+#include "Common/StateCache.h"
 
 #include <gtest/gtest.h>
 

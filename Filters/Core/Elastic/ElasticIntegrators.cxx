@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Time integration of the meshless elastic solid: symplectic Euler [4.28-4.30], contacts [4.26], containers and
 // plasticity. The implicit integrator is in ElasticImplicit.cxx.
-#include "ElasticMath.h"
-#include "ElasticSolid.h"
+#include "Elastic/ElasticMath.h"
+#include "Elastic/ElasticSolid.h"
 
 #include <algorithm>
 #include <cmath>

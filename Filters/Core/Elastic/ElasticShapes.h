@@ -5,7 +5,7 @@
 #ifndef meshfree_ElasticShapes_h
 #define meshfree_ElasticShapes_h
 
-#include "NeighborGrid.h"
+#include "Common/NeighborGrid.h"
 
 #include <algorithm>
 #include <string>

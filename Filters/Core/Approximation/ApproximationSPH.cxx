@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // SPH interpolation (thesis 2.3, 5.10): A(x) = sum_j A_j V_j W(|x - x_j|, h), optionally Shepard-normalised.
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <algorithm>
 #include <cmath>

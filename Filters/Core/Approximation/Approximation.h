@@ -43,9 +43,9 @@
 #ifndef meshfree_Approximation_h
 #define meshfree_Approximation_h
 
-#include "Kernels.h"
-#include "LocalFit.h"
-#include "NeighborGrid.h"
+#include "Common/Kernels.h"
+#include "Common/LocalFit.h"
+#include "Common/NeighborGrid.h"
 
 #include <functional>
 #include <memory>

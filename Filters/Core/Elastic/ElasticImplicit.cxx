@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Implicit integration of the meshless elastic solid: linearised backward Euler (M - dt^2 K) v+ = M v + dt F
 // [4.31-4.42], solved matrix-free by Jacobi-preconditioned conjugate gradients.
-#include "ElasticMath.h"
-#include "ElasticSolid.h"
+#include "Elastic/ElasticMath.h"
+#include "Elastic/ElasticSolid.h"
 
 #include <Eigen/Dense>
 

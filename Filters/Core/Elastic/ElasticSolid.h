@@ -47,8 +47,8 @@
 #ifndef meshfree_ElasticSolid_h
 #define meshfree_ElasticSolid_h
 
-#include "Kernels.h"
-#include "NeighborGrid.h"
+#include "Common/Kernels.h"
+#include "Common/NeighborGrid.h"
 
 #include <functional>
 #include <string>

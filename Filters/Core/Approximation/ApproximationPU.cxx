@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // PU-WLS (thesis 3.16-3.21): local WLS fits at lattice centres blended by a partition of unity. The choice
 // of the centres is documented in Approximation.h.
-#include "ApproximationPU.h"
+#include "Approximation/ApproximationPU.h"
 
 #include <algorithm>
 #include <cmath>

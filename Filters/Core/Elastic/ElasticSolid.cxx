@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Meshless elastic solid (Mueller et al. 2004): model set-up, strain/stress, forces, symplectic Euler.
 // The model is described in ElasticSolid.h; the implicit integrator is in ElasticImplicit.cxx.
-#include "ElasticSolid.h"
-#include "ElasticMath.h"
+#include "Elastic/ElasticSolid.h"
+#include "Elastic/ElasticMath.h"
 
 #include <Eigen/Dense>
 

@@ -1,4 +1,4 @@
-#include "SPHBoundary.h"
+#include "SPH/SPHBoundary.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Meshless elastic solid: deformation gradient from the MLS fit, Green strain, Hooke stress, and the elastic,
 // volume and hourglass forces in the momentum-conserving packet form (see ElasticSolid.h).
-#include "ElasticMath.h"
-#include "ElasticSolid.h"
+#include "Elastic/ElasticMath.h"
+#include "Elastic/ElasticSolid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Approximator: cloud set-up (exclusions, neighbour grid, intrinsic frame), the evaluation loop, LS/WLS and
 // MLS. PU-WLS is in ApproximationPU.cxx, SPH in ApproximationSPH.cxx.
-#include "Approximation.h"
-#include "ApproximationPU.h"
+#include "Approximation/Approximation.h"
+#include "Approximation/ApproximationPU.h"
 
 #include <algorithm>
 #include <cctype>

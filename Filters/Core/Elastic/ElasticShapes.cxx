@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "ElasticShapes.h"
+#include "Elastic/ElasticShapes.h"
 
-#include "ElasticSolid.h"
+#include "Elastic/ElasticSolid.h"
 
 #include <array>
 #include <cmath>

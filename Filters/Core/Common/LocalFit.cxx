@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Run-time dispatch of the templated local fits (LocalFit.h) on (dimension, degree), and the fits with many
 // right-hand sides used by LS, WLS and PU-WLS.
-#include "LocalFit.h"
+#include "Common/LocalFit.h"
 
 #include <vector>
 

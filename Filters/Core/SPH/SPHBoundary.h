@@ -9,7 +9,7 @@
 #ifndef meshfree_SPHBoundary_h
 #define meshfree_SPHBoundary_h
 
-#include "NeighborGrid.h"
+#include "Common/NeighborGrid.h"
 
 #include <vector>
 

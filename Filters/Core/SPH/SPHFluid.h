@@ -69,7 +69,7 @@
 #ifndef meshfree_SPHFluid_h
 #define meshfree_SPHFluid_h
 
-#include "NeighborGrid.h"
+#include "Common/NeighborGrid.h"
 
 #include <cmath>
 #include <cstdint>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "NeighborGrid.h"
+#include "Common/NeighborGrid.h"
 
 #include <algorithm>
 #include <atomic>

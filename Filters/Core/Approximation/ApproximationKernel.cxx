@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Approximator: MLS shape functions for a neighbour list chosen by the caller (VTK's interpolation-kernel
 // protocol: ComputeBasis picks the points, ComputeWeights weighs them).
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <algorithm>
 #include <cmath>

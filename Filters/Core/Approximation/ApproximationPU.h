@@ -3,7 +3,7 @@
 #ifndef meshfree_ApproximationPU_h
 #define meshfree_ApproximationPU_h
 
-#include "Approximation.h"
+#include "Approximation/Approximation.h"
 
 #include <vector>
 

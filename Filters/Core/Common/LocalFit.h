@@ -20,9 +20,9 @@
 #ifndef meshfree_LocalFit_h
 #define meshfree_LocalFit_h
 
-#include "Kernels.h"
-#include "NeighborGrid.h"
-#include "PolynomialBasis.h"
+#include "Common/Kernels.h"
+#include "Common/NeighborGrid.h"
+#include "Common/PolynomialBasis.h"
 
 #include <Eigen/Dense>
 

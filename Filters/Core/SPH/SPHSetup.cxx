@@ -1,8 +1,8 @@
 // SPH fluid core, part 1: parameters, kernels and their lattice corrections, boundary particles and the initial
 // state (the model is described in SPHFluid.h). Part 2, the time stepping, is SPHFluid.cxx.
-#include "SPHFluid.h"
+#include "SPH/SPHFluid.h"
 
-#include "SPHBoundary.h"
+#include "SPH/SPHBoundary.h"
 
 #include <algorithm>
 #include <cmath>

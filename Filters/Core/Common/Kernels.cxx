@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // MeshFree core: weight functions. Formulas and thesis equation numbers: see Kernels.h.
-#include "Kernels.h"
+#include "Common/Kernels.h"
 
 #include <cctype>
 #include <cstdio>

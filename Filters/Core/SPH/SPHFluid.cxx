@@ -1,6 +1,6 @@
 // SPH fluid core, part 2: neighbour lists, density and forces, leap-frog stepping (the model is described in
 // SPHFluid.h). Part 1, the setup and initial state, is SPHSetup.cxx.
-#include "SPHFluid.h"
+#include "SPH/SPHFluid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Approximator: the parallel evaluation loop (blocks for progress and abort, per-thread scratch) and the
 // global fits of LS (3.1-3.7) and WLS (3.8-3.15).
-#include "Approximation.h"
-#include "ApproximationPU.h"
+#include "Approximation/Approximation.h"
+#include "Approximation/ApproximationPU.h"
 
 #include <algorithm>
 #include <cmath>
