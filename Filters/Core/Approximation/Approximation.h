@@ -46,6 +46,7 @@
 #include "Common/Kernels.h"
 #include "Common/LocalFit.h"
 #include "Common/NeighborGrid.h"
+#include "Common/Progress.h"
 
 #include <functional>
 #include <memory>
@@ -110,8 +111,6 @@ struct ApproximationReport
   bool Aborted = false;
 };
 
-/// Called between blocks of evaluation points with the fraction done; return false to abort.
-using ProgressCallback = std::function<bool(double)>;
 
 class Approximator
 {

@@ -1001,6 +1001,17 @@ void NeighborGrid::FindWithinRadius(
   });
 }
 
+void NeighborGrid::FindWithinRadiusPositions(
+  const double x[3], double radius, std::vector<Index>& positions, std::vector<double>& dist2) const
+{
+  positions.clear();
+  dist2.clear();
+  this->FilterRadius(x, radius, [&](int found, const double* d2, const Index* pos) {
+    positions.insert(positions.end(), pos, pos + found);
+    dist2.insert(dist2.end(), d2, d2 + found);
+  });
+}
+
 void NeighborGrid::FindWithinRadiusSorted(
   const double x[3], double radius, std::vector<Index>& ids, std::vector<double>& dist2) const
 {

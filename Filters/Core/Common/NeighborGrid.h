@@ -139,6 +139,11 @@ public:
   /// Morton order of the cells (unsorted by distance).
   void FindWithinRadius(const double x[3], double radius, std::vector<Index>& ids,
     std::vector<double>* dist2 = nullptr) const;
+  /// As FindWithinRadius(), but gives sorted positions (indices into SortedPoints()/SortedOrder()) instead
+  /// of original indices, and always the squared distances: callers that keep their per-point data in the
+  /// sorted order read it contiguously.
+  void FindWithinRadiusPositions(
+    const double x[3], double radius, std::vector<Index>& positions, std::vector<double>& dist2) const;
   /// As FindWithinRadius(), sorted ascending by (squared distance, original index).
   void FindWithinRadiusSorted(
     const double x[3], double radius, std::vector<Index>& ids, std::vector<double>& dist2) const;

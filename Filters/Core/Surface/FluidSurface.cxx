@@ -1,0 +1,266 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// SPH colour-field surface of a particle fluid, isotropic or with Yu & Turk's anisotropic kernels
+// (FluidSurface.h).
+#include "Surface/FluidSurface.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+
+namespace meshfree
+{
+
+namespace
+{
+constexpr double Pi = 3.141592653589793238462643383279502884;
+
+double Median(std::vector<double> v)
+{
+  if (v.empty())
+  {
+    return 0.0;
+  }
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + mid, v.end());
+  return v[mid];
+}
+} // namespace
+
+bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes, const FluidSurfaceOptions& options)
+{
+  this->Grid = &grid;
+  this->Options = options;
+  this->Unit = Kernel(KernelType::Wendland, 3, 1.0);
+  const Index n = grid.NumberOfPoints();
+  const Index nv = grid.NumberOfValidPoints();
+  this->Boundary.assign(static_cast<size_t>(n), 0);
+  this->Volumes.clear();
+  this->Centres.clear();
+  this->Transforms.clear();
+  this->Determinants.clear();
+  this->Volume = 0.0;
+  if (nv == 0)
+  {
+    this->H = 0.0;
+    return false;
+  }
+  const double* sorted = grid.SortedPoints();
+  const std::vector<Index>& order = grid.SortedOrder();
+
+  // The kernel radius: twice the spacing that the k-nearest balls of a sample of particles give.
+  constexpr int k = 20;
+  const Index samples = std::min<Index>(nv, 2048);
+  std::vector<double> kth(static_cast<size_t>(samples), 0.0);
+#pragma omp parallel
+  {
+    std::vector<Index> ids;
+    std::vector<double> d2;
+#pragma omp for schedule(dynamic, 16)
+    for (Index j = 0; j < samples; ++j)
+    {
+      const int found = grid.FindKNearest(sorted + 3 * (j * nv / samples), k + 1, ids, d2);
+      kth[j] = found > 0 ? std::sqrt(d2[found - 1]) : 0.0;
+    }
+  }
+  const double rk = Median(kth);
+  const double spacing0 = rk * std::cbrt(4.0 / 3.0 * Pi / (k + 1));
+  this->H = options.SupportRadius > 0.0 ? options.SupportRadius : 2.0 * spacing0;
+  if (!(this->H > 0.0) || !std::isfinite(this->H))
+  {
+    // One particle, or all at one place: a kernel of unit size relative to nothing; take the bounds or 1.
+    double b[6];
+    grid.GetBounds(b);
+    const double extent = std::max({ b[1] - b[0], b[3] - b[2], b[5] - b[4] });
+    this->H = extent > 0.0 ? extent : 1.0;
+  }
+
+  // Number densities sum_k W(|x_j - x_k|, H) (the particle itself included).
+  std::vector<double> density(static_cast<size_t>(nv), 0.0);
+  const double invH = 1.0 / this->H;
+  const double invH3 = invH * invH * invH;
+#pragma omp parallel
+  {
+    std::vector<Index> pos;
+    std::vector<double> d2;
+#pragma omp for schedule(dynamic, 256)
+    for (Index s = 0; s < nv; ++s)
+    {
+      grid.FindWithinRadiusPositions(sorted + 3 * s, this->H, pos, d2);
+      double sum = 0.0;
+      for (double r2 : d2)
+      {
+        sum += this->Unit.ValueSquared(r2 * invH * invH);
+      }
+      density[s] = sum * invH3;
+    }
+  }
+  const double bulk = Median(density);
+  const double v0 = bulk > 0.0 ? 1.0 / bulk : std::pow(this->H * 0.5, 3);
+  this->ParticleSpacing = std::cbrt(v0);
+  this->Volumes.assign(static_cast<size_t>(nv), v0);
+  for (Index s = 0; s < nv; ++s)
+  {
+    const Index id = order[s];
+    if (volumes && volumes[id] > 0.0 && std::isfinite(volumes[id]))
+    {
+      this->Volumes[s] = volumes[id];
+    }
+    this->Volume += this->Volumes[s];
+    const double colour = density[s] * v0;
+    this->Boundary[id] = colour < 0.9 || colour > 1.1 ? 1 : 0;
+  }
+  this->QueryRadius = this->H;
+  if (!options.Anisotropic)
+  {
+    return true;
+  }
+
+  // Anisotropic kernels: weighted PCA of the neighbours within twice the spacing.
+  const double reach = 2.0 * this->ParticleSpacing;
+  const double ratio = std::max(1.0, options.AnisotropyRatio);
+  const double lambda = std::min(1.0, std::max(0.0, options.Smoothing));
+  this->Centres.assign(static_cast<size_t>(3 * nv), 0.0);
+  this->Transforms.assign(static_cast<size_t>(9 * nv), 0.0);
+  double largestStretch = 1.0, largestShift = 0.0;
+#pragma omp parallel reduction(max : largestStretch, largestShift)
+  {
+    std::vector<Index> pos;
+    std::vector<double> d2;
+#pragma omp for schedule(dynamic, 256)
+    for (Index s = 0; s < nv; ++s)
+    {
+      const double* x = sorted + 3 * s;
+      grid.FindWithinRadiusPositions(x, reach, pos, d2);
+      double sw = 0.0;
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (size_t j = 0; j < pos.size(); ++j)
+      {
+        const double q = std::sqrt(d2[j]) / reach;
+        const double w = 1.0 - q * q * q;
+        const double* p = sorted + 3 * pos[j];
+        mean += w * Eigen::Vector3d(p[0] - x[0], p[1] - x[1], p[2] - x[2]);
+        sw += w;
+      }
+      mean /= sw; // sw >= 1: the particle itself
+      Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+      for (size_t j = 0; j < pos.size(); ++j)
+      {
+        const double q = std::sqrt(d2[j]) / reach;
+        const double w = 1.0 - q * q * q;
+        const double* p = sorted + 3 * pos[j];
+        const Eigen::Vector3d d = Eigen::Vector3d(p[0] - x[0], p[1] - x[1], p[2] - x[2]) - mean;
+        C.noalias() += w * d * d.transpose();
+      }
+      C /= sw;
+      Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
+      if (static_cast<int>(pos.size()) >= options.MinimumNeighbors)
+      {
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+        eig.computeDirect(C);
+        Eigen::Vector3d sigma = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt(); // ascending
+        const double top = sigma(2);
+        if (top > 0.0 && std::isfinite(top))
+        {
+          sigma = sigma.cwiseMax(top / ratio);
+          // Stretches of unit product: the kernel keeps the isotropic kernel's volume.
+          const Eigen::Vector3d stretch = sigma / std::cbrt(sigma(0) * sigma(1) * sigma(2));
+          M = eig.eigenvectors() * stretch.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+          largestStretch = std::max(largestStretch, stretch.maxCoeff());
+        }
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        this->Centres[3 * s + a] = x[a] + lambda * mean(a);
+        for (int b = 0; b < 3; ++b)
+        {
+          this->Transforms[9 * s + 3 * a + b] = M(a, b);
+        }
+      }
+      largestShift = std::max(largestShift, lambda * mean.norm());
+    }
+  }
+  this->QueryRadius = this->H * largestStretch + largestShift;
+  return true;
+}
+
+double FluidSurface::Colour(const double x[3], FieldScratch& s) const
+{
+  double value = 0.0;
+  this->Evaluate(x, value, nullptr, s);
+  return this->Options.Level - value;
+}
+
+bool FluidSurface::Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& s) const
+{
+  if (!this->Grid || !(this->H > 0.0))
+  {
+    return false;
+  }
+  this->Grid->FindWithinRadiusPositions(x, this->QueryRadius, s.Positions, s.Dist2);
+  const double invH = 1.0 / this->H;
+  const double invH3 = invH * invH * invH;
+  double c = 0.0, g[3] = { 0.0, 0.0, 0.0 };
+  const size_t found = s.Positions.size();
+  if (this->Transforms.empty())
+  {
+    const double* sorted = this->Grid->SortedPoints();
+    for (size_t j = 0; j < found; ++j)
+    {
+      const Index p = s.Positions[j];
+      const double q = std::sqrt(s.Dist2[j]) * invH;
+      if (!(q < 1.0))
+      {
+        continue;
+      }
+      const double v = this->Volumes[p] * invH3;
+      c += v * this->Unit.Value(q);
+      if (gradient && q > 0.0)
+      {
+        const double dw = v * this->Unit.RadialDerivative(q) * invH / (q * this->H);
+        for (int a = 0; a < 3; ++a)
+        {
+          g[a] += dw * (x[a] - sorted[3 * p + a]);
+        }
+      }
+    }
+  }
+  else
+  {
+    for (size_t j = 0; j < found; ++j)
+    {
+      const Index p = s.Positions[j];
+      const double* m = &this->Transforms[9 * p];
+      const double r[3] = { x[0] - this->Centres[3 * p], x[1] - this->Centres[3 * p + 1], x[2] - this->Centres[3 * p + 2] };
+      const double u[3] = { m[0] * r[0] + m[1] * r[1] + m[2] * r[2], m[3] * r[0] + m[4] * r[1] + m[5] * r[2],
+        m[6] * r[0] + m[7] * r[1] + m[8] * r[2] };
+      const double q = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) * invH;
+      if (!(q < 1.0))
+      {
+        continue;
+      }
+      const double v = this->Volumes[p] * invH3;
+      c += v * this->Unit.Value(q);
+      if (gradient && q > 0.0)
+      {
+        // grad |M r| = M^T u / |u| (M symmetric).
+        const double dw = v * this->Unit.RadialDerivative(q) * invH / (q * this->H);
+        for (int a = 0; a < 3; ++a)
+        {
+          g[a] += dw * (m[a] * u[0] + m[3 + a] * u[1] + m[6 + a] * u[2]);
+        }
+      }
+    }
+  }
+  value = this->Options.Level - c;
+  if (gradient)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      gradient[a] = -g[a];
+    }
+  }
+  return std::isfinite(value);
+}
+
+} // namespace meshfree

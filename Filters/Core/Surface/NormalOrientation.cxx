@@ -1,0 +1,306 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Minimum-spanning-tree propagation of normal orientation (NormalOrientation.h).
+#include "Surface/NormalOrientation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace meshfree
+{
+
+namespace
+{
+/// Binary min-heap of point indices keyed by cost, with decrease-key (each point at most once).
+class IndexedHeap
+{
+public:
+  explicit IndexedHeap(Index n)
+    : Where(static_cast<size_t>(n), -1)
+  {
+  }
+  bool Empty() const { return this->Items.empty(); }
+  /// Inserts i or lowers its key.
+  void Push(std::int32_t i, float key)
+  {
+    if (this->Where[i] < 0)
+    {
+      this->Items.push_back(Item{ key, i });
+      this->Where[i] = static_cast<std::int32_t>(this->Items.size() - 1);
+    }
+    else
+    {
+      this->Items[this->Where[i]].Key = key;
+    }
+    this->Up(this->Where[i]);
+  }
+  std::int32_t Pop()
+  {
+    const std::int32_t top = this->Items[0].Id;
+    this->Where[top] = -1;
+    const Item last = this->Items.back();
+    this->Items.pop_back();
+    if (!this->Items.empty())
+    {
+      this->Items[0] = last;
+      this->Where[last.Id] = 0;
+      this->Down(0);
+    }
+    return top;
+  }
+
+private:
+  struct Item
+  {
+    float Key;
+    std::int32_t Id;
+    bool operator<(const Item& o) const { return this->Key != o.Key ? this->Key < o.Key : this->Id < o.Id; }
+  };
+  void Place(std::int32_t slot, const Item& item)
+  {
+    this->Items[slot] = item;
+    this->Where[item.Id] = slot;
+  }
+  void Up(std::int32_t slot)
+  {
+    const Item item = this->Items[slot];
+    while (slot > 0)
+    {
+      const std::int32_t parent = (slot - 1) / 2;
+      if (!(item < this->Items[parent]))
+      {
+        break;
+      }
+      this->Place(slot, this->Items[parent]);
+      slot = parent;
+    }
+    this->Place(slot, item);
+  }
+  void Down(std::int32_t slot)
+  {
+    const Item item = this->Items[slot];
+    const std::int32_t size = static_cast<std::int32_t>(this->Items.size());
+    for (;;)
+    {
+      std::int32_t child = 2 * slot + 1;
+      if (child >= size)
+      {
+        break;
+      }
+      if (child + 1 < size && this->Items[child + 1] < this->Items[child])
+      {
+        ++child;
+      }
+      if (!(this->Items[child] < item))
+      {
+        break;
+      }
+      this->Place(slot, this->Items[child]);
+      slot = child;
+    }
+    this->Place(slot, item);
+  }
+  std::vector<Item> Items;
+  std::vector<std::int32_t> Where;
+};
+
+inline double Dot(const double* a, const double* b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/// The neighbour graph of the valid points, made symmetric, in compressed rows indexed by sorted position.
+void SymmetricGraph(const NormalField& field, const std::vector<Index>& order, const std::vector<std::int32_t>& rank,
+  std::vector<Index>& offsets, std::vector<std::int32_t>& adjacent)
+{
+  const int k = field.GraphDegree;
+  const Index nv = static_cast<Index>(order.size());
+  offsets.assign(static_cast<size_t>(nv + 1), 0);
+  auto edges = [&](auto&& visit) {
+    for (Index s = 0; s < nv; ++s)
+    {
+      const Index id = order[s];
+      if (!field.Valid[id])
+      {
+        continue;
+      }
+      for (int j = 0; j < k; ++j)
+      {
+        const std::int32_t v = field.Graph[static_cast<size_t>(id) * k + j];
+        if (v >= 0 && field.Valid[v])
+        {
+          visit(static_cast<std::int32_t>(s), rank[v]);
+        }
+      }
+    }
+  };
+  edges([&](std::int32_t a, std::int32_t b) {
+    ++offsets[a + 1];
+    ++offsets[b + 1];
+  });
+  for (Index s = 0; s < nv; ++s)
+  {
+    offsets[s + 1] += offsets[s];
+  }
+  adjacent.resize(static_cast<size_t>(offsets[nv]));
+  std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
+  edges([&](std::int32_t a, std::int32_t b) {
+    adjacent[fill[a]++] = b;
+    adjacent[fill[b]++] = a;
+  });
+}
+} // namespace
+
+OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, const OrientationOptions& options,
+  std::vector<double>& confidence)
+{
+  OrientationReport report;
+  const Index n = static_cast<Index>(field.Valid.size());
+  confidence.assign(static_cast<size_t>(n), 0.0);
+
+  if (options.Mode == OrientationMode::Reference && options.Reference)
+  {
+    for (Index i = 0; i < n; ++i)
+    {
+      const double* r = options.Reference + 3 * i;
+      const double len = std::sqrt(Dot(r, r));
+      if (!field.Valid[i] || !(len > 0.0) || !std::isfinite(len))
+      {
+        continue;
+      }
+      double* m = &field.Normals[3 * i];
+      const double c = Dot(m, r) / len;
+      if (c < 0.0)
+      {
+        m[0] = -m[0];
+        m[1] = -m[1];
+        m[2] = -m[2];
+      }
+      confidence[i] = std::fabs(c);
+      report.Ambiguous += confidence[i] < 0.5 ? 1 : 0;
+    }
+    return report;
+  }
+
+  // Everything in the grid's sorted order.
+  const std::vector<Index>& order = grid.SortedOrder();
+  const double* xyz = grid.SortedPoints();
+  const Index nv = static_cast<Index>(order.size());
+  std::vector<std::int32_t> rank(static_cast<size_t>(n), -1);
+  std::vector<double> normals(static_cast<size_t>(3 * nv));
+  std::vector<unsigned char> valid(static_cast<size_t>(nv));
+  for (Index s = 0; s < nv; ++s)
+  {
+    rank[order[s]] = static_cast<std::int32_t>(s);
+    std::copy(&field.Normals[3 * order[s]], &field.Normals[3 * order[s]] + 3, &normals[3 * s]);
+    valid[s] = field.Valid[order[s]];
+  }
+  std::vector<Index> offsets;
+  std::vector<std::int32_t> adjacent;
+  SymmetricGraph(field, order, rank, offsets, adjacent);
+  std::vector<double> sortedConfidence(static_cast<size_t>(nv), 0.0);
+  std::vector<unsigned char> done(static_cast<size_t>(nv), 0);
+  std::vector<std::int32_t> parent(static_cast<size_t>(nv), -1);
+  std::vector<float> key(static_cast<size_t>(nv), std::numeric_limits<float>::infinity());
+  std::vector<std::int32_t> members;
+  IndexedHeap heap(nv);
+  for (Index seed = 0; seed < nv; ++seed)
+  {
+    if (!valid[seed] || done[seed])
+    {
+      continue;
+    }
+    ++report.Components;
+    members.clear();
+    heap.Push(static_cast<std::int32_t>(seed), 0.0f);
+    key[seed] = 0.0f;
+    while (!heap.Empty())
+    {
+      const std::int32_t u = heap.Pop();
+      done[u] = 1;
+      members.push_back(u);
+      double* nu = &normals[3 * u];
+      if (parent[u] >= 0)
+      {
+        const double c = Dot(nu, &normals[3 * parent[u]]);
+        if (c < 0.0)
+        {
+          nu[0] = -nu[0];
+          nu[1] = -nu[1];
+          nu[2] = -nu[2];
+        }
+        sortedConfidence[u] = std::fabs(c);
+      }
+      else
+      {
+        sortedConfidence[u] = 1.0;
+      }
+      for (Index e = offsets[u]; e < offsets[u + 1]; ++e)
+      {
+        const std::int32_t v = adjacent[e];
+        if (done[v])
+        {
+          continue;
+        }
+        const float cost = static_cast<float>(1.0 - std::fabs(Dot(nu, &normals[3 * v])));
+        if (cost < key[v])
+        {
+          key[v] = cost;
+          parent[v] = u;
+          heap.Push(v, cost);
+        }
+      }
+    }
+    // The component as a whole: outward (or towards the viewpoint).
+    double centre[3] = { 0.0, 0.0, 0.0 };
+    if (options.Mode == OrientationMode::Viewpoint)
+    {
+      std::copy(options.Viewpoint, options.Viewpoint + 3, centre);
+    }
+    else
+    {
+      // Relative to the seed, so that clouds far from the origin keep their precision.
+      const double* o = xyz + 3 * seed;
+      for (std::int32_t m : members)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          centre[a] += xyz[3 * m + a] - o[a];
+        }
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        centre[a] = o[a] + centre[a] / static_cast<double>(members.size());
+      }
+    }
+    double flux = 0.0;
+    for (std::int32_t m : members)
+    {
+      const double d[3] = { xyz[3 * m] - centre[0], xyz[3 * m + 1] - centre[1], xyz[3 * m + 2] - centre[2] };
+      flux += Dot(&normals[3 * m], d);
+    }
+    const bool flip = options.Mode == OrientationMode::Viewpoint ? flux > 0.0 : flux < 0.0;
+    if (flip)
+    {
+      ++report.FlippedComponents;
+      for (std::int32_t m : members)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          normals[3 * m + a] = -normals[3 * m + a];
+        }
+      }
+    }
+  }
+  for (Index s = 0; s < nv; ++s)
+  {
+    const Index id = order[s];
+    std::copy(&normals[3 * s], &normals[3 * s] + 3, &field.Normals[3 * id]);
+    confidence[id] = valid[s] ? sortedConfidence[s] : 0.0;
+    report.Ambiguous += valid[s] && sortedConfidence[s] < 0.5 ? 1 : 0;
+  }
+  return report;
+}
+
+} // namespace meshfree

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class meshfree::PatchSurface
+ * @brief The WLS surface: a partition of unity of local weighted least-squares fits (Ohtake et al. 2003,
+ *        "Multi-level partition of unity implicits", single level; thesis 3.16-3.21 for PU-WLS).
+ *
+ * Patches: one per occupied cell of a coarse grid of edge rho/2 (rho the median fit support of the cloud):
+ * its centre c is the mean of the cell's points, its frame (t1, t2, n) has n = the mean of their outward
+ * normals. Over the points within rho of c, weighted by Wendland(|p - c| / rho), it fits the height
+ * h = g(u, v) of degree 2 in the frame's coordinates (u, v, h) = ((p - c) . (t1, t2, n)) / rho - shifted and
+ * scaled, solved by the equilibrated rank-revealing moment solve of LocalFit.h (SolveMoment); degenerate fits
+ * fall back to degree 1, then 0, then the patch is dropped. Its local field is the height above the fitted
+ * graph, divided by sqrt(1 + |grad g|^2) (a first-order distance):
+ *
+ *   Q_c(x) = rho (h - g(u, v)) / sqrt(1 + g_u^2 + g_v^2),     f(x) = sum_c w_c(x) Q_c(x) / sum_c w_c(x),
+ *
+ * w_c = Wendland(|x - c| / rho). The fit is done once per patch, not per evaluation point: evaluation visits
+ * the few patches within rho instead of every neighbour point, which makes WLS cheaper than MLS; a quadric
+ * per patch also follows curvature without the plane's O(kappa rho^2) bias. Undefined where no patch reaches.
+ */
+#ifndef meshfree_PatchSurface_h
+#define meshfree_PatchSurface_h
+
+#include "Common/NeighborGrid.h"
+#include "Surface/ImplicitField.h"
+
+#include <vector>
+
+namespace meshfree
+{
+
+class PatchSurface : public ImplicitField
+{
+public:
+  /// The cloud as for PointSetSurface::SetCloud(): grid, unit outward normals and fit supports (caller's
+  /// order; points with a zero normal or radius are ignored).
+  void SetCloud(const NeighborGrid& grid, const double* normals, const double* radii);
+
+  bool Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& scratch) const override;
+
+  Index NumberOfPatches() const { return static_cast<Index>(this->Radius.size()); }
+
+private:
+  NeighborGrid Centres;          // the patches' centres
+  std::vector<double> Frames;    // 9 per patch, rows t1, t2, n (patch order = Centres' input order)
+  std::vector<double> Heights;   // 6 coefficients per patch: 1, u, v, u^2, uv, v^2 (scaled coordinates)
+  std::vector<double> Radius;    // rho per patch
+  std::vector<double> Positions; // 3 per patch
+  double QueryRadius = 0.0;
+};
+
+} // namespace meshfree
+
+#endif

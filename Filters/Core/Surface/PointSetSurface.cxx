@@ -1,0 +1,146 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// APSS: the moving algebraic-sphere fit of PointSetSurface.h.
+#include "Surface/PointSetSurface.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace meshfree
+{
+
+void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, const double* radii)
+{
+  this->Grid = &grid;
+  const std::vector<Index>& order = grid.SortedOrder();
+  const Index nv = static_cast<Index>(order.size());
+  this->Normals.assign(static_cast<size_t>(3 * nv), 0.0);
+  this->InverseRadii.assign(static_cast<size_t>(nv), 0.0);
+  double largest = 0.0;
+  for (Index s = 0; s < nv; ++s)
+  {
+    const Index id = order[s];
+    const double* n = &normals[3 * id];
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double r = radii[id];
+    if (!(len > 0.0) || !std::isfinite(len) || !(r > 0.0) || !std::isfinite(r))
+    {
+      continue;
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Normals[3 * s + a] = n[a] / len;
+    }
+    this->InverseRadii[s] = 1.0 / r;
+    largest = std::max(largest, r);
+  }
+  this->QueryRadius = largest;
+}
+
+bool PointSetSurface::Fit(const double x[3], SphereFit& fit, FieldScratch& s) const
+{
+  if (!this->Grid || !(this->QueryRadius > 0.0))
+  {
+    return false;
+  }
+  this->Grid->FindWithinRadiusPositions(x, this->QueryRadius, s.Positions, s.Dist2);
+  const size_t found = s.Positions.size();
+  if (found < static_cast<size_t>(this->MinimumNeighbors))
+  {
+    return false;
+  }
+  // One pass, two sets of moments (centred on x, scaled by H): neighbours whose normal agrees with the first
+  // weighted neighbour's, and the others. The heavier set is fitted; the other is the far side of a sheet
+  // thinner than the support (or a few flipped normals), which must not be averaged in.
+  struct Moments
+  {
+    double W = 0.0, D[3] = { 0.0, 0.0, 0.0 }, N[3] = { 0.0, 0.0, 0.0 }, DN = 0.0, DD = 0.0;
+    int Count = 0;
+  } sets[2];
+  const double invH = 1.0 / this->QueryRadius;
+  const double* xyz = this->Grid->SortedPoints();
+  const double* normals = this->Normals.data();
+  const double* reference = nullptr;
+  for (size_t j = 0; j < found; ++j)
+  {
+    const Index p = s.Positions[j];
+    const double q = std::sqrt(s.Dist2[j]) * this->InverseRadii[p];
+    if (!(q < 1.0))
+    {
+      continue;
+    }
+    const double u = 1.0 - q;
+    const double w = u * u * u * u * (4.0 * q + 1.0);
+    const double* n = normals + 3 * p;
+    reference = reference ? reference : n;
+    Moments& m = sets[n[0] * reference[0] + n[1] * reference[1] + n[2] * reference[2] > 0.0 ? 0 : 1];
+    const double d[3] = { (xyz[3 * p] - x[0]) * invH, (xyz[3 * p + 1] - x[1]) * invH, (xyz[3 * p + 2] - x[2]) * invH };
+    m.W += w;
+    for (int a = 0; a < 3; ++a)
+    {
+      m.D[a] += w * d[a];
+      m.N[a] += w * n[a];
+    }
+    m.DN += w * (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
+    m.DD += w * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    ++m.Count;
+  }
+  const Moments& m = sets[sets[1].W > sets[0].W ? 1 : 0];
+  const int used = m.Count;
+  const double sw = m.W, sdn = m.DN, sdd = m.DD;
+  const double* sd = m.D;
+  const double* sn = m.N;
+  if (used < this->MinimumNeighbors || !(sw > 0.0))
+  {
+    return false;
+  }
+  const double inv = 1.0 / sw;
+  const double A[3] = { sd[0] * inv, sd[1] * inv, sd[2] * inv };
+  const double B[3] = { sn[0] * inv, sn[1] * inv, sn[2] * inv };
+  const double C = sdn * inv, D = sdd * inv;
+  const double AA = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
+  const double AB = A[0] * B[0] + A[1] * B[1] + A[2] * B[2];
+  const double spread = D - AA;
+  const double uq = spread > 1e-12 ? 0.5 * (C - AB) / spread : 0.0;
+  double ul[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    ul[a] = B[a] - 2.0 * uq * A[a];
+  }
+  const double u0 = -(ul[0] * A[0] + ul[1] * A[1] + ul[2] * A[2]) - uq * D;
+  const double norm = std::sqrt(ul[0] * ul[0] + ul[1] * ul[1] + ul[2] * ul[2]);
+  if (!(norm > 1e-2) || !std::isfinite(norm) || !std::isfinite(u0))
+  {
+    return false; // the normals cancel: no side is outside
+  }
+  const double disc = norm * norm - 4.0 * u0 * uq;
+  // Distance to the sphere; an imaginary sphere (inconsistent data) falls back to the plane's distance.
+  const double distance = disc >= 0.0 ? 2.0 * u0 / (norm + std::sqrt(disc)) : u0 / norm;
+  fit.Distance = distance * this->QueryRadius;
+  for (int a = 0; a < 3; ++a)
+  {
+    fit.Direction[a] = ul[a] / norm;
+  }
+  fit.Curvature = 2.0 * uq / norm * invH;
+  fit.Neighbors = used;
+  return std::isfinite(fit.Distance) && std::isfinite(fit.Curvature);
+}
+
+bool PointSetSurface::Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& scratch) const
+{
+  SphereFit fit;
+  if (!this->Fit(x, fit, scratch))
+  {
+    return false;
+  }
+  value = fit.Distance;
+  if (gradient)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      gradient[a] = fit.Direction[a];
+    }
+  }
+  return true;
+}
+
+} // namespace meshfree

@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class meshfree::PointSetSurface
+ * @brief The MLS point-set surface of an oriented cloud: algebraic point-set surfaces (APSS, Guennebaud &
+ *        Gross 2007), a moving fit of an algebraic sphere to the points and their normals.
+ *
+ * At an evaluation point x, with neighbours p_i, unit normals n_i and weights w_i = theta(|p_i - x| / h_i)
+ * (Wendland, per-point support h_i), in coordinates d_i = (p_i - x) / H (shifted to x and scaled by the query
+ * radius H, so clouds far from the origin or at extreme scales lose nothing) and normalised weights
+ * w~_i = w_i / sum w:
+ *
+ *   s(d) = u0 + u_l . d + u_q |d|^2,
+ *   u_q = 1/2 (sum w~ d.n - (sum w~ d).(sum w~ n)) / (sum w~ |d|^2 - |sum w~ d|^2)
+ *   u_l = sum w~ n - 2 u_q sum w~ d,       u0 = -u_l . sum w~ d - u_q sum w~ |d|^2
+ *
+ * (research/surface.md §1). The field is the signed distance from x to that sphere, in the form that stays
+ * stable as the sphere flattens into a plane (u_q -> 0):
+ *
+ *   f(x) = H * 2 u0 / (|u_l| + sqrt(|u_l|^2 - 4 u0 u_q)),
+ *
+ * negative inside (the normals point outward), with the sphere's gradient u_l / |u_l| as its direction. The
+ * sphere reproduces spheres and planes exactly. Its mean curvature at the surface is 2 u_q / (|u_l| H)
+ * (positive where the surface is convex).
+ *
+ * Fallback chain: a support whose spread vanishes (all neighbours on one point) gives the plane u_q = 0;
+ * fewer than MinimumNeighbors weighted neighbours, normals that cancel (|u_l| tiny: both sides of a thin
+ * sheet) or a negative discriminant far from the surface give "undefined", never a made-up value.
+ * Neighbours whose normal opposes the support's mean normal (the far side of a sheet thinner than the
+ * support) are dropped before the fit (RIMLS's normal term, research §4 "Thin features").
+ */
+#ifndef meshfree_PointSetSurface_h
+#define meshfree_PointSetSurface_h
+
+#include "Common/NeighborGrid.h"
+#include "Surface/ImplicitField.h"
+
+#include <vector>
+
+namespace meshfree
+{
+
+/// The algebraic sphere fitted at one point, in world units.
+struct SphereFit
+{
+  double Distance = 0.0;   // signed distance from the evaluation point to the sphere (negative inside)
+  double Direction[3] = { 0.0, 0.0, 1.0 }; // unit gradient of the sphere at the evaluation point
+  double Curvature = 0.0;  // mean curvature of the sphere (1 / radius, + convex), 0 for a plane
+  int Neighbors = 0;       // weighted neighbours used
+};
+
+class PointSetSurface : public ImplicitField
+{
+public:
+  /// The cloud: `grid` built over n points, their unit outward normals and support radii h_i (both in the
+  /// caller's point order; copied into the grid's sorted order). Points without a valid normal (a zero or
+  /// non-finite vector) or radius are ignored.
+  void SetCloud(const NeighborGrid& grid, const double* normals, const double* radii);
+
+  /// Fits need at least this many weighted neighbours (default 6).
+  void SetMinimumNeighbors(int count) { this->MinimumNeighbors = count < 3 ? 3 : count; }
+
+  /// The sphere fitted at x. False where undefined (see the class comment).
+  bool Fit(const double x[3], SphereFit& fit, FieldScratch& scratch) const;
+
+  /// f(x) = the fitted sphere's signed distance; the gradient is its unit direction, so Project() is the MLS
+  /// projection (move onto the sphere fitted at x, refit there, repeat).
+  bool Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& scratch) const override;
+
+  /// Largest support radius of the cloud (the neighbour query's radius).
+  double MaximumRadius() const { return this->QueryRadius; }
+
+private:
+  const NeighborGrid* Grid = nullptr;
+  std::vector<double> Normals; // sorted order, 3 per point
+  std::vector<double> InverseRadii; // sorted order; 0 for ignored points
+  double QueryRadius = 0.0;
+  int MinimumNeighbors = 6;
+};
+
+} // namespace meshfree
+
+#endif

@@ -1,0 +1,432 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The surface-reconstruction driver (SurfaceReconstruction.h): validate, scales, field, contour, project.
+#include "Surface/SurfaceReconstruction.h"
+
+#include "Surface/FluidSurface.h"
+#include "Surface/PatchSurface.h"
+#include "Surface/PointSetSurface.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+namespace meshfree
+{
+
+const char* SurfaceMethodName(SurfaceMethod method)
+{
+  switch (method)
+  {
+    case SurfaceMethod::MLS:
+      return "MLS";
+    case SurfaceMethod::WLS:
+      return "WLS";
+    case SurfaceMethod::SPH:
+      return "SPH";
+  }
+  return "Unknown";
+}
+
+namespace
+{
+double Median(std::vector<double> v)
+{
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !(x > 0.0); }), v.end());
+  if (v.empty())
+  {
+    return 0.0;
+  }
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + mid, v.end());
+  return v[mid];
+}
+
+/// A sub-range [begin, end) of the progress scale.
+ProgressCallback Stage(const ProgressCallback& progress, double begin, double end)
+{
+  if (!progress)
+  {
+    return ProgressCallback();
+  }
+  return [progress, begin, end](double f) { return progress(begin + (end - begin) * f); };
+}
+
+/// Unit normals from the input; a point without a usable one gets radius 0 (ignored by the fits).
+Index TakeNormals(const SurfaceInput& input, NormalField& field)
+{
+  Index missing = 0;
+  for (Index i = 0; i < input.Count; ++i)
+  {
+    const double* n = input.Normals + 3 * i;
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0.0) || !std::isfinite(len) || !field.Valid[i])
+    {
+      field.Radii[i] = 0.0;
+      field.Valid[i] = 0;
+      ++missing;
+      continue;
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      field.Normals[3 * i + a] = n[a] / len;
+    }
+  }
+  return missing;
+}
+
+/// Lattice origin and cell size around the grid's bounds with a margin; the cell grows when the bounds
+/// would need more lattice cells than there are.
+void ChooseLattice(const NeighborGrid& grid, double cell, double margin, ContourOptions& lattice, bool& enlarged)
+{
+  double b[6];
+  grid.GetBounds(b);
+  double extent = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    extent = std::max(extent, b[2 * a + 1] - b[2 * a]);
+  }
+  // Room for the data, the margins on both sides and growth beyond them.
+  const double usable = static_cast<double>(SparseContour::kMaximumCoordinate) / 2.0;
+  enlarged = false;
+  if ((extent + 2.0 * margin) / cell > usable)
+  {
+    cell = (extent + 2.0 * margin) / usable;
+    enlarged = true;
+  }
+  lattice.CellSize = cell;
+  for (int a = 0; a < 3; ++a)
+  {
+    // Centre the data in the lattice's coordinate range so that growth has room on every side.
+    const double centre = 0.5 * (b[2 * a] + b[2 * a + 1]);
+    lattice.Origin[a] = centre - usable * cell;
+  }
+}
+
+/// Seed cells of the continuation: per occupied block of 4^3 lattice cells, its first chosen point is moved
+/// onto the surface (a few projection steps, at most `reach` away) and the cell it lands in is a seed; a point
+/// that cannot be projected seeds its own cell. Every piece of surface near the data gets many seeds, yet
+/// only the cells the surface crosses are evaluated (seeding every occupied cell would evaluate the whole
+/// noisy shell of points, several cells thick).
+std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitField& field, const ContourOptions& lattice,
+  double reach, const std::vector<unsigned char>& chosen)
+{
+  const std::vector<Index>& order = grid.SortedOrder();
+  const double* sorted = grid.SortedPoints();
+  const Index nv = static_cast<Index>(order.size());
+  // One representative per block (the sorted order is by grid cell, not by block: sort the block keys).
+  std::vector<std::pair<std::uint64_t, Index>> blocks;
+  blocks.reserve(static_cast<size_t>(nv));
+  for (Index s = 0; s < nv; ++s)
+  {
+    Index c[3];
+    if (chosen[order[s]] && SparseContour::CellOf(sorted + 3 * s, lattice, c))
+    {
+      blocks.emplace_back(SparseContour::CellKey(c[0] >> 2, c[1] >> 2, c[2] >> 2), s);
+    }
+  }
+  std::sort(blocks.begin(), blocks.end());
+  blocks.erase(std::unique(blocks.begin(), blocks.end(),
+                 [](const std::pair<std::uint64_t, Index>& a, const std::pair<std::uint64_t, Index>& b) {
+                   return a.first == b.first;
+                 }),
+    blocks.end());
+  const Index count = static_cast<Index>(blocks.size());
+  std::vector<std::uint64_t> seeds(static_cast<size_t>(count), 0);
+  std::vector<unsigned char> ok(static_cast<size_t>(count), 0);
+#pragma omp parallel
+  {
+    FieldScratch scratch;
+#pragma omp for schedule(dynamic, 64)
+    for (Index b = 0; b < count; ++b)
+    {
+      double x[3], n[3];
+      std::copy(sorted + 3 * blocks[b].second, sorted + 3 * blocks[b].second + 3, x);
+      field.Project(x, n, reach, 3, scratch);
+      Index c[3];
+      if (SparseContour::CellOf(x, lattice, c))
+      {
+        seeds[b] = SparseContour::CellKey(c[0], c[1], c[2]);
+        ok[b] = 1;
+      }
+    }
+  }
+  std::vector<std::uint64_t> kept;
+  kept.reserve(seeds.size());
+  for (Index b = 0; b < count; ++b)
+  {
+    if (ok[b])
+    {
+      kept.push_back(seeds[b]);
+    }
+  }
+  return kept;
+}
+
+/// Moves the vertices onto the surface and sets their normals; vertices that cannot be projected keep
+/// their place and get the mean of their triangles' normals.
+Index ProjectVertices(const ImplicitField& field, double maxStep, bool project, SurfaceMesh& mesh)
+{
+  const Index nv = mesh.NumberOfPoints();
+  mesh.Normals.assign(static_cast<size_t>(3 * nv), 0.0);
+  std::vector<unsigned char> done(static_cast<size_t>(nv), 0);
+  Index projected = 0;
+#pragma omp parallel reduction(+ : projected)
+  {
+    FieldScratch scratch;
+#pragma omp for schedule(dynamic, 512)
+    for (Index v = 0; v < nv; ++v)
+    {
+      double* x = &mesh.Points[3 * v];
+      double* n = &mesh.Normals[3 * v];
+      if (project)
+      {
+        if (field.Project(x, n, maxStep, 1, scratch))
+        {
+          done[v] = 1;
+          ++projected;
+        }
+        continue;
+      }
+      double f = 0.0, g[3];
+      const double len = field.Evaluate(x, f, g, scratch) ? std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) : 0.0;
+      if (len > 0.0 && std::isfinite(len))
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          n[a] = g[a] / len;
+        }
+        done[v] = 1;
+      }
+    }
+  }
+  // Triangle normals (area-weighted) for the rest.
+  const Index nt = mesh.NumberOfTriangles();
+  std::vector<double> sum(static_cast<size_t>(3 * nv), 0.0);
+  bool any = false;
+  for (Index v = 0; v < nv && !any; ++v)
+  {
+    any = !done[v];
+  }
+  if (!any)
+  {
+    return projected;
+  }
+  for (Index t = 0; t < nt; ++t)
+  {
+    const Index* id = &mesh.Triangles[3 * t];
+    const double* a = &mesh.Points[3 * id[0]];
+    const double* b = &mesh.Points[3 * id[1]];
+    const double* c = &mesh.Points[3 * id[2]];
+    const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+    const double w[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+    const double cross[3] = { u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0] };
+    for (int k = 0; k < 3; ++k)
+    {
+      for (int q = 0; q < 3; ++q)
+      {
+        sum[3 * id[k] + q] += cross[q];
+      }
+    }
+  }
+  for (Index v = 0; v < nv; ++v)
+  {
+    if (done[v])
+    {
+      continue;
+    }
+    const double* s = &sum[3 * v];
+    const double len = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    for (int a = 0; a < 3; ++a)
+    {
+      mesh.Normals[3 * v + a] = len > 0.0 ? s[a] / len : (a == 2 ? 1.0 : 0.0);
+    }
+  }
+  return projected;
+}
+} // namespace
+
+bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options, SurfaceMesh& mesh,
+  SurfaceReport& report, std::string& error, const ProgressCallback& progress)
+{
+  mesh = SurfaceMesh();
+  report = SurfaceReport();
+  error.clear();
+  report.InputPoints = input.Count;
+  if (options.NeighborCount < 3 || options.NeighborCount > 10000)
+  {
+    error = "NeighborCount must be between 3 and 10000.";
+    return false;
+  }
+  if (!(options.SupportRadius >= 0.0) || !std::isfinite(options.SupportRadius) || !(options.CellSize >= 0.0) ||
+    !std::isfinite(options.CellSize))
+  {
+    error = "SupportRadius and CellSize must be finite and >= 0.";
+    return false;
+  }
+  if (!(options.SupportScale >= 1.0) || !(options.SupportScale <= 100.0))
+  {
+    error = "SupportScale must be between 1 and 100.";
+    return false;
+  }
+  if (options.Method == SurfaceMethod::SPH && (!(options.Level > 0.0) || !(options.Level < 1.0)))
+  {
+    error = "The SPH surface level must lie strictly between 0 and 1 (the colour field's range).";
+    return false;
+  }
+  if (input.Count < 0 || (input.Count > 0 && !input.Points))
+  {
+    error = "No point coordinates given.";
+    return false;
+  }
+
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); };
+  auto start = Clock::now();
+  NeighborGrid grid;
+  grid.Build(input.Points, input.Count);
+  report.InvalidPoints = grid.NumberOfInvalidPoints();
+  if (grid.NumberOfValidPoints() == 0)
+  {
+    return true;
+  }
+
+  std::unique_ptr<ImplicitField> field;
+  std::vector<std::uint64_t> seeds;
+  ContourOptions lattice;
+  lattice.MaximumRounds = options.MaximumRounds;
+  double cell = options.CellSize;
+  double margin = 0.0;
+  if (options.Method == SurfaceMethod::SPH)
+  {
+    auto fluid = std::make_unique<FluidSurface>();
+    FluidSurfaceOptions fo;
+    fo.SupportRadius = options.SupportRadius;
+    fo.Level = options.Level;
+    fo.Anisotropic = options.Anisotropic;
+    fluid->SetParticles(grid, input.Volumes, fo);
+    report.SupportRadius = fluid->SupportRadius();
+    report.ParticleVolume = fluid->TotalVolume();
+    if (!(cell > 0.0))
+    {
+      cell = 0.5 * fluid->Spacing();
+    }
+    margin = 2.0 * fluid->SupportRadius();
+    ChooseLattice(grid, cell, margin, lattice, report.CellSizeEnlarged);
+    std::vector<unsigned char> near(static_cast<size_t>(input.Count), 0);
+    for (Index i = 0; i < input.Count; ++i)
+    {
+      near[i] = fluid->NearSurface(i) ? 1 : 0;
+    }
+    seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near);
+    field = std::move(fluid);
+    if (progress && !progress(0.2))
+    {
+      report.Aborted = true;
+      return false;
+    }
+  }
+  else
+  {
+    // Neighbourhoods (and normals, unless given).
+    NormalOptions no;
+    no.NeighborCount = options.NeighborCount;
+    no.SupportRadius = options.SupportRadius;
+    NormalField normals;
+    if (!EstimateNormals(grid, no, normals, Stage(progress, 0.0, 0.15)) && progress && !progress(0.15))
+    {
+      report.Aborted = true;
+      return false;
+    }
+    report.Scale = normals.Scale;
+    if (input.Normals)
+    {
+      report.PointsWithoutNormal = TakeNormals(input, normals) - report.InvalidPoints;
+    }
+    else
+    {
+      report.NormalsEstimated = true;
+      std::vector<double> confidence;
+      report.Orientation = OrientNormals(grid, normals, OrientationOptions(), confidence);
+      report.PointsWithoutNormal = normals.InvalidCount - report.InvalidPoints;
+    }
+    // The fits' support: SupportScale x r_k bridges the gaps of random sampling; where the noise asks for a
+    // wider neighbourhood, NoiseScale x that radius averages the noise (both are in SurfaceOptions).
+    std::vector<double> support(normals.Radii);
+    for (Index i = 0; i < input.Count; ++i)
+    {
+      if (support[i] > 0.0 && !(options.SupportRadius > 0.0))
+      {
+        support[i] = std::max(options.SupportScale * normals.NeighborDistance[i], options.NoiseScale * normals.Scale.Radius);
+      }
+      else
+      {
+        support[i] *= options.SupportScale;
+      }
+    }
+    report.SupportRadius = Median(support);
+    // Isolated points (outliers, the tails of the noise) have a far k-th neighbour; one huge support would
+    // widen every neighbour query of the fits (their radius is the largest support), so supports are capped
+    // at three times the median.
+    for (double& r : support)
+    {
+      r = std::min(r, 3.0 * report.SupportRadius);
+    }
+    if (!(cell > 0.0))
+    {
+      // A quarter of the fits' support (finer detail than that the fit cannot represent), but not below 1.5
+      // sample spacings (about 0.7 vertices per sample): the projection makes accuracy independent of it.
+      cell = std::max(1.5 * normals.Scale.Spacing, 0.25 * report.SupportRadius);
+    }
+    if (!(cell > 0.0))
+    {
+      return true; // every normal is invalid (collinear or coincident points): no surface
+    }
+    margin = 2.0 * report.SupportRadius;
+    ChooseLattice(grid, cell, margin, lattice, report.CellSizeEnlarged);
+    if (options.Method == SurfaceMethod::MLS)
+    {
+      auto apss = std::make_unique<PointSetSurface>();
+      apss->SetCloud(grid, normals.Normals.data(), support.data());
+      field = std::move(apss);
+    }
+    else
+    {
+      auto patches = std::make_unique<PatchSurface>();
+      patches->SetCloud(grid, normals.Normals.data(), support.data());
+      field = std::move(patches);
+    }
+    seeds = SeedCells(grid, *field, lattice, report.SupportRadius, normals.Valid);
+    if (progress && !progress(0.2))
+    {
+      report.Aborted = true;
+      return false;
+    }
+  }
+  report.CellSize = lattice.CellSize;
+  report.SetupSeconds = seconds(start);
+  start = Clock::now();
+  if (!SparseContour().Run(*field, std::move(seeds), lattice, mesh, report.Contour, Stage(progress, 0.2, 0.85)))
+  {
+    report.Aborted = report.Contour.Aborted;
+    mesh = SurfaceMesh();
+    if (!report.Aborted)
+    {
+      error = "The contouring lattice could not be set up.";
+    }
+    return false;
+  }
+  report.ContourSeconds = seconds(start);
+  start = Clock::now();
+  report.ProjectedVertices = ProjectVertices(*field, lattice.CellSize, options.ProjectVertices, mesh);
+  report.ProjectionSeconds = seconds(start);
+  if (progress && !progress(1.0))
+  {
+    report.Aborted = true;
+    mesh = SurfaceMesh();
+    return false;
+  }
+  return true;
+}
+
+} // namespace meshfree

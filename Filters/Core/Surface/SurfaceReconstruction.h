@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @brief Triangle mesh of the surface a point cloud (or a particle fluid) samples: the driver that chains
+ *        normals, an implicit surface and the sparse contouring (research/surface.md).
+ *
+ * Methods
+ * - MLS (default): the algebraic point-set surface (PointSetSurface.h) of the oriented cloud.
+ * - WLS: a partition of unity of local weighted least-squares fits (PatchSurface.h; Ohtake's MPU idea).
+ * - SPH: the colour-field surface of particles (FluidSurface.h); no normals needed.
+ * For MLS and WLS, normals are taken from the input when given (unit-normalised; invalid ones make the point
+ * ignored), otherwise estimated and oriented outward (SurfaceNormals.h, NormalOrientation.h).
+ *
+ * Scales (all automatic unless set): the neighbourhood radius R_i of every point follows its density (its
+ * NeighborCount-th neighbour) and the cloud's noise (SurfaceNormals.h); the implicit fits use SupportScale x R_i
+ * (wide enough to bridge the gaps of random sampling, research §4 "Support too small = holes");
+ * SupportRadius > 0 fixes R_i. CellSize 0 picks the spacing of the samples (MLS, WLS) or half the particle
+ * spacing (SPH), enlarged when the lattice would exceed 2^21 cells per axis.
+ *
+ * The mesh is closed wherever the field is defined (SparseContour.h); its vertices are then moved onto the
+ * surface (Project(), at most one cell) and get the field's unit outward gradient as normal, or the mean of
+ * their triangles' normals where the projection fails.
+ */
+#ifndef meshfree_SurfaceReconstruction_h
+#define meshfree_SurfaceReconstruction_h
+
+#include "Common/NeighborGrid.h"
+#include "Common/Progress.h"
+#include "Surface/NormalOrientation.h"
+#include "Surface/SparseContour.h"
+#include "Surface/SurfaceNormals.h"
+
+#include <string>
+#include <vector>
+
+namespace meshfree
+{
+
+enum class SurfaceMethod
+{
+  MLS = 0,
+  WLS = 1,
+  SPH = 2
+};
+
+/// "MLS", "WLS", "SPH".
+const char* SurfaceMethodName(SurfaceMethod method);
+
+struct SurfaceOptions
+{
+  SurfaceMethod Method = SurfaceMethod::MLS;
+  int NeighborCount = 20;      // MLS/WLS: the smallest neighbourhood (see SurfaceNormals.h)
+  double SupportRadius = 0.0;  // > 0: MLS/WLS neighbourhood radius R, SPH kernel radius H
+  double SupportScale = 2.0;   // MLS/WLS: the fits' support relative to r_k (or to SupportRadius)
+  double NoiseScale = 2.0;     // MLS/WLS: ... and at least this times the radius the noise asks for
+  double CellSize = 0.0;       // 0: automatic
+  double Level = 0.5;          // SPH: colour level of the surface
+  bool Anisotropic = false;    // SPH: Yu & Turk's anisotropic kernels
+  bool ProjectVertices = true; // move the contour's vertices onto the surface
+  int MaximumRounds = 512;     // continuation rounds of the contouring
+};
+
+struct SurfaceInput
+{
+  const double* Points = nullptr;  // 3 per point
+  Index Count = 0;
+  const double* Normals = nullptr; // 3 per point, outward (MLS/WLS), optional
+  const double* Volumes = nullptr; // V_j = m_j / rho_j (SPH), optional
+};
+
+struct SurfaceReport
+{
+  Index InputPoints = 0;
+  Index InvalidPoints = 0;      // NaN/Inf coordinates
+  Index PointsWithoutNormal = 0; // MLS/WLS: no valid normal (given or estimated); ignored by the fits
+  bool NormalsEstimated = false;
+  OrientationReport Orientation;
+  CloudScale Scale;             // MLS/WLS: spacing, noise, noise radius
+  double CellSize = 0.0;        // used
+  bool CellSizeEnlarged = false; // the requested or automatic size needed more lattice cells than exist
+  double SupportRadius = 0.0;   // median fit support (MLS/WLS) or kernel radius H (SPH)
+  double ParticleVolume = 0.0;  // SPH: total volume of the particles
+  ContourReport Contour;
+  Index ProjectedVertices = 0;
+  // Wall-clock seconds of the stages: neighbourhoods, normals and the field's set-up; contouring; projection.
+  double SetupSeconds = 0.0;
+  double ContourSeconds = 0.0;
+  double ProjectionSeconds = 0.0;
+  bool Aborted = false;
+};
+
+/// The surface: triangles, and per vertex a unit outward normal.
+struct SurfaceMesh : TriangleMesh
+{
+  std::vector<double> Normals;
+};
+
+/// Reconstructs the surface of the input. Returns false with `error` set for invalid options, and false
+/// (empty mesh, report.Aborted) when aborted. An input without valid points gives an empty mesh and true.
+bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options, SurfaceMesh& mesh,
+  SurfaceReport& report, std::string& error, const ProgressCallback& progress = ProgressCallback());
+
+} // namespace meshfree
+
+#endif
