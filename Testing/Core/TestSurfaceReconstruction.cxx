@@ -7,6 +7,7 @@
 // neighbours averaged grow as sigma / h): x 1.5; without noise the APSS/quadric fit's error is O(h^3): x 11.
 #include "Surface/MeshTopology.h"
 #include "Surface/SurfaceReconstruction.h"
+#include "SurfaceSamples.h"
 
 #include <gtest/gtest.h>
 
@@ -16,73 +17,17 @@
 #include <vector>
 
 using namespace meshfree;
+namespace samples = meshfree::testing;
 
 namespace
 {
-constexpr double RingRadius = 1.0, TubeRadius = 0.35;
+using samples::RingRadius;
+using samples::TubeRadius;
+using Cloud = samples::SurfaceCloud;
 
-struct Cloud
+Cloud Sample(bool torus, Index n, double sigma)
 {
-  std::vector<double> Points, Normals;
-  bool Torus = false;
-  Index Count() const { return static_cast<Index>(this->Points.size() / 3); }
-};
-
-/// n points uniform by area on the unit sphere or the torus, Gaussian noise sigma per axis, exact normals.
-Cloud Sample(bool torus, Index n, double sigma, unsigned seed = 12345)
-{
-  Cloud c;
-  c.Torus = torus;
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> g;
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-  while (c.Count() < n)
-  {
-    double p[3], m[3];
-    if (!torus)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        p[a] = g(rng);
-      }
-      const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-      for (int a = 0; a < 3; ++a)
-      {
-        p[a] /= r;
-        m[a] = p[a];
-      }
-    }
-    else
-    {
-      const double u = 2.0 * M_PI * u01(rng), v = 2.0 * M_PI * u01(rng);
-      if (u01(rng) * (RingRadius + TubeRadius) >= RingRadius + TubeRadius * std::cos(v))
-      {
-        continue; // area element (R + r cos v)
-      }
-      const double ring = RingRadius + TubeRadius * std::cos(v);
-      p[0] = ring * std::cos(u);
-      p[1] = ring * std::sin(u);
-      p[2] = TubeRadius * std::sin(v);
-      m[0] = std::cos(v) * std::cos(u);
-      m[1] = std::cos(v) * std::sin(u);
-      m[2] = std::sin(v);
-    }
-    for (int a = 0; a < 3; ++a)
-    {
-      c.Points.push_back(p[a] + sigma * g(rng));
-      c.Normals.push_back(m[a]);
-    }
-  }
-  return c;
-}
-
-double SignedDistance(const double* p, bool torus)
-{
-  if (!torus)
-  {
-    return std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) - 1.0;
-  }
-  return std::hypot(std::hypot(p[0], p[1]) - RingRadius, p[2]) - TubeRadius;
+  return samples::SampleSurface(torus, n, sigma);
 }
 
 struct Score
@@ -105,30 +50,12 @@ Score Evaluate(const SurfaceMesh& mesh, bool torus)
       ++s.NonFinite;
       continue;
     }
-    const double d = SignedDistance(p, torus);
+    const double d = samples::SurfaceDistance(p, torus);
     s.Rms += d * d;
     s.Bias += d;
     s.Max = std::max(s.Max, std::fabs(d));
-    // The true outward normal at the nearest surface point.
     double t[3];
-    if (!torus)
-    {
-      const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-      for (int a = 0; a < 3; ++a)
-      {
-        t[a] = p[a] / r;
-      }
-    }
-    else
-    {
-      const double rho = std::hypot(p[0], p[1]);
-      const double q[3] = { p[0] - RingRadius * p[0] / rho, p[1] - RingRadius * p[1] / rho, p[2] };
-      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-      for (int a = 0; a < 3; ++a)
-      {
-        t[a] = q[a] / len;
-      }
-    }
+    samples::SurfaceNormal(p, torus, t);
     const double c = std::max(-1.0, std::min(1.0, n[0] * t[0] + n[1] * t[1] + n[2] * t[2]));
     s.WorstNormal = std::max(s.WorstNormal, std::acos(c));
   }

@@ -1001,6 +1001,60 @@ void NeighborGrid::FindWithinRadius(
   });
 }
 
+Index NeighborGrid::FindDuplicates(std::vector<Index>& representative) const
+{
+  representative.assign(static_cast<size_t>(this->NumberOfInputPoints), -1);
+  const Index cells = this->GridDims[0] * this->GridDims[1] * this->GridDims[2];
+  const CellRange* ranges = this->CellRanges.data();
+  const double* xyz = this->Sorted.data();
+  const Index* order = this->Order.data();
+  Index duplicates = 0;
+  // Equal coordinates fall into one cell: sort each cell's points by (x, y, z, index) and group.
+#pragma omp parallel reduction(+ : duplicates)
+  {
+    std::vector<Index> pos;
+#pragma omp for schedule(dynamic, 1024)
+    for (Index c = 0; c < cells; ++c)
+    {
+      const CellRange r = ranges[c];
+      if (r.End <= r.Begin)
+      {
+        continue;
+      }
+      pos.clear();
+      for (Index s = r.Begin; s < r.End; ++s)
+      {
+        pos.push_back(s);
+      }
+      std::sort(pos.begin(), pos.end(), [xyz, order](Index a, Index b) {
+        for (int k = 0; k < 3; ++k)
+        {
+          if (xyz[3 * a + k] != xyz[3 * b + k])
+          {
+            return xyz[3 * a + k] < xyz[3 * b + k];
+          }
+        }
+        return order[a] < order[b];
+      });
+      Index first = pos[0];
+      representative[order[first]] = order[first];
+      for (size_t j = 1; j < pos.size(); ++j)
+      {
+        const Index s = pos[j];
+        const bool same = xyz[3 * s] == xyz[3 * first] && xyz[3 * s + 1] == xyz[3 * first + 1] &&
+          xyz[3 * s + 2] == xyz[3 * first + 2];
+        if (!same)
+        {
+          first = s;
+        }
+        representative[order[s]] = order[first];
+        duplicates += same ? 1 : 0;
+      }
+    }
+  }
+  return duplicates;
+}
+
 void NeighborGrid::FindWithinRadiusPositions(
   const double x[3], double radius, std::vector<Index>& positions, std::vector<double>& dist2) const
 {

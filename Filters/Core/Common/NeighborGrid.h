@@ -174,6 +174,11 @@ public:
   bool FindWithinRadiusForAllPoints(
     double radius, std::vector<Index>& offsets, std::vector<std::int32_t>& ids, bool excludeSelf = false) const;
 
+  /// Exact duplicates: representative[i] (NumberOfPoints() entries) is the smallest original index of the
+  /// valid points with exactly the same coordinates as point i (i itself when it has none; -1 for invalid
+  /// points). Returns how many valid points are duplicates of a smaller index. O(n), parallel.
+  Index FindDuplicates(std::vector<Index>& representative) const;
+
   ///@{
   /// The Morton-sorted layout. SortedOrder()[s] is the original index of the point at sorted position s
   /// (valid points only); SortedPoints() holds their coordinates, interleaved x, y, z, in that order.

@@ -110,7 +110,8 @@ inline double Dot(const double* a, const double* b)
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/// The neighbour graph of the valid points, made symmetric, in compressed rows indexed by sorted position.
+/// The neighbour graph of the valid points, outliers left out (a random normal in the tree would flip the
+/// whole subtree beyond it), made symmetric, in compressed rows indexed by sorted position.
 void SymmetricGraph(const NormalField& field, const std::vector<Index>& order, const std::vector<std::int32_t>& rank,
   std::vector<Index>& offsets, std::vector<std::int32_t>& adjacent)
 {
@@ -121,14 +122,14 @@ void SymmetricGraph(const NormalField& field, const std::vector<Index>& order, c
     for (Index s = 0; s < nv; ++s)
     {
       const Index id = order[s];
-      if (!field.Valid[id])
+      if (!field.Valid[id] || field.Outlier[id])
       {
         continue;
       }
       for (int j = 0; j < k; ++j)
       {
         const std::int32_t v = field.Graph[static_cast<size_t>(id) * k + j];
-        if (v >= 0 && field.Valid[v])
+        if (v >= 0 && field.Valid[v] && !field.Outlier[v])
         {
           visit(static_cast<std::int32_t>(s), rank[v]);
         }
@@ -194,7 +195,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   {
     rank[order[s]] = static_cast<std::int32_t>(s);
     std::copy(&field.Normals[3 * order[s]], &field.Normals[3 * order[s]] + 3, &normals[3 * s]);
-    valid[s] = field.Valid[order[s]];
+    valid[s] = field.Valid[order[s]] && !field.Outlier[order[s]];
   }
   std::vector<Index> offsets;
   std::vector<std::int32_t> adjacent;
@@ -299,6 +300,33 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     std::copy(&normals[3 * s], &normals[3 * s] + 3, &field.Normals[3 * id]);
     confidence[id] = valid[s] ? sortedConfidence[s] : 0.0;
     report.Ambiguous += valid[s] && sortedConfidence[s] < 0.5 ? 1 : 0;
+  }
+  // Outliers follow their nearest oriented neighbour.
+  const int k = field.GraphDegree;
+  for (Index i = 0; i < n; ++i)
+  {
+    if (!field.Valid[i] || !field.Outlier[i])
+    {
+      continue;
+    }
+    for (int j = 0; j < k; ++j)
+    {
+      const std::int32_t v = field.Graph[static_cast<size_t>(i) * k + j];
+      if (v >= 0 && field.Valid[v] && !field.Outlier[v])
+      {
+        double* m = &field.Normals[3 * i];
+        const double c = Dot(m, &field.Normals[3 * v]);
+        if (c < 0.0)
+        {
+          m[0] = -m[0];
+          m[1] = -m[1];
+          m[2] = -m[2];
+        }
+        confidence[i] = std::fabs(c);
+        break;
+      }
+    }
+    report.Ambiguous += confidence[i] < 0.5 ? 1 : 0;
   }
   return report;
 }

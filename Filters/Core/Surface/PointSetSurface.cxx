@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace meshfree
 {
@@ -14,7 +15,8 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
   this->Normals.assign(static_cast<size_t>(3 * nv), 0.0);
-  this->InverseRadii.assign(static_cast<size_t>(nv), 0.0);
+  // Ignored points get an infinite inverse radius: q = inf (or NaN at distance 0) is never < 1.
+  this->InverseRadii.assign(static_cast<size_t>(nv), std::numeric_limits<double>::infinity());
   double largest = 0.0;
   for (Index s = 0; s < nv; ++s)
   {

@@ -72,7 +72,7 @@ public:
 private:
   const NeighborGrid* Grid = nullptr;
   std::vector<double> Normals; // sorted order, 3 per point
-  std::vector<double> InverseRadii; // sorted order; 0 for ignored points
+  std::vector<double> InverseRadii; // sorted order; +inf for ignored points
   double QueryRadius = 0.0;
   int MinimumNeighbors = 6;
 };

@@ -2,6 +2,8 @@
 // PCA normals over a density- and noise-adapted neighbourhood (SurfaceNormals.h).
 #include "Surface/SurfaceNormals.h"
 
+#include "Common/LocalFit.h"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -19,8 +21,33 @@ struct LocalPCA
 {
   double Normal[3] = { 0.0, 0.0, 0.0 };
   double Eigenvalues[3] = { 0.0, 0.0, 0.0 }; // ascending, in world units squared
+  double Residual = 0.0; // distance from the point to its neighbourhood's quadric (or plane)
   bool Valid = false;
 };
+
+/// The k nearest neighbours of x at a nonzero distance (exact duplicates of x are not neighbours: they add
+/// nothing to the sampling), preceded by x's duplicates (itself included). Returns how many were found in
+/// all; kth gets the distance to the k-th distinct one (or the farthest found).
+int NearestDistinct(const NeighborGrid& grid, const double x[3], int k, std::vector<Index>& ids,
+  std::vector<double>& d2, double& kth)
+{
+  int want = k + 1;
+  for (;;)
+  {
+    const int found = grid.FindKNearest(x, want, ids, d2);
+    int zeros = 0;
+    while (zeros < found && d2[zeros] == 0.0)
+    {
+      ++zeros;
+    }
+    if (found < want || found - zeros >= k || want > (1 << 16))
+    {
+      kth = found > zeros ? std::sqrt(d2[std::min(found, zeros + k) - 1]) : 0.0;
+      return found;
+    }
+    want = zeros + k;
+  }
+}
 
 /// PCA of the points at sorted positions pos[0..count) of `sorted`, about their centroid, in coordinates
 /// shifted to x and scaled by 1/scale.
@@ -64,18 +91,59 @@ LocalPCA PrincipalAxes(const double* sorted, const Index* pos, size_t count, con
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   eig.computeDirect(C);
   const Eigen::Vector3d l = eig.eigenvalues();
-  // Collinear or coincident neighbours leave the plane undetermined.
-  if (!(l(1) > 1e-12 * l(2)) || !(l(2) > 0.0) || !std::isfinite(l(2)))
+  // Collinear or coincident neighbours leave the plane undetermined. (The closed-form solver's eigenvalues
+  // are accurate to ~1e-9 of the largest, so a relative width below 1e-3 counts as a line.)
+  if (!(l(1) > 1e-6 * l(2)) || !(l(2) > 0.0) || !std::isfinite(l(2)))
   {
     return out;
   }
-  const Eigen::Vector3d n = eig.eigenvectors().col(0).normalized();
+  Eigen::Vector3d n = eig.eigenvectors().col(0).normalized();
+  // Jet refinement (Cazals & Pouget 2005): the height over the PCA plane of the neighbours (the point itself
+  // left out) fitted by a quadric,
+  // h = a0 + a1 u + a2 v + a3 u^2 + a4 uv + a5 v^2, in the point's frame; the normal at the point is
+  // n - a1 t1 - a2 t2. Exact on quadrics, where PCA is biased by O(kappa R) (0.16-0.45 degrees at k = 20).
+  // For a symmetric support the slopes are orthogonal to the quadratic terms, so noise tilts them no
+  // more than PCA's plane. Fewer than 2 neighbours per term, or a degenerate fit, keep the PCA normal.
+  if (count >= 12)
+  {
+    const Eigen::Vector3d t1 = eig.eigenvectors().col(2).normalized();
+    const Eigen::Vector3d t2 = n.cross(t1);
+    Eigen::Matrix<double, 6, 6> M = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> B = Eigen::Matrix<double, 6, 1>::Zero();
+    for (size_t j = 0; j < count; ++j)
+    {
+      const double* p = sorted + 3 * pos[j];
+      const Eigen::Vector3d d((p[0] - x[0]) * inv, (p[1] - x[1]) * inv, (p[2] - x[2]) * inv);
+      if (d.squaredNorm() == 0.0)
+      {
+        continue; // the point itself (and its duplicates): its distance to its neighbours' quadric is the residual
+      }
+      const double u = d.dot(t1), v = d.dot(t2);
+      Eigen::Matrix<double, 6, 1> b;
+      b << 1.0, u, v, u * u, u * v, v * v;
+      M.selfadjointView<Eigen::Upper>().rankUpdate(b);
+      B.noalias() += d.dot(n) * b;
+    }
+    M.triangularView<Eigen::StrictlyLower>() = M.transpose();
+    Eigen::Matrix<double, 6, 1> a;
+    double condition = 0.0;
+    if (SolveMoment<6>(M, B, a, false, condition) && a.allFinite())
+    {
+      n = (n - a(1) * t1 - a(2) * t2).normalized();
+      out.Residual = std::fabs(a(0)) * scale;
+    }
+  }
+  if (!(out.Residual > 0.0))
+  {
+    // No quadric: the distance from the point to the plane through the centroid.
+    out.Residual = std::fabs(n(0) * m1[0] + n(1) * m1[1] + n(2) * m1[2]) * scale;
+  }
   for (int a = 0; a < 3; ++a)
   {
     out.Normal[a] = n(a);
     out.Eigenvalues[a] = std::max(0.0, l(a)) * scale * scale;
   }
-  out.Valid = std::isfinite(n(0)) && std::isfinite(n(1)) && std::isfinite(n(2));
+  out.Valid = n.allFinite();
   return out;
 }
 
@@ -90,26 +158,26 @@ double Median(std::vector<double> v)
   return v[mid];
 }
 
-/// From a radius query's result (sorted positions `pos`, squared distances `r2`) around the point at sorted
-/// position `self`: the distance to its k-th nearest other point and its `degree` nearest others (original
-/// indices, ordered by (distance, index) like NeighborGrid::FindKNearest). `pairs` is scratch.
-void NearestOfList(const std::vector<Index>& pos, const std::vector<double>& r2, Index self, int k,
+/// From a radius query's result (sorted positions `pos`, squared distances `r2`) around a point: the distance
+/// to its k-th nearest other point and its `degree` nearest others (original indices, ordered by (distance,
+/// index) like NeighborGrid::FindKNearest), exact duplicates of the point left out. False (nothing written)
+/// when the list holds fewer than k such points. `pairs` is scratch.
+bool NearestOfList(const std::vector<Index>& pos, const std::vector<double>& r2, int k,
   const std::vector<Index>& order, std::int32_t* row, int degree, double& kth,
   std::vector<std::pair<double, Index>>& pairs)
 {
   pairs.clear();
   for (size_t j = 0; j < pos.size(); ++j)
   {
-    if (pos[j] != self)
+    if (r2[j] > 0.0) // the point itself and its exact duplicates are not neighbours
     {
       pairs.emplace_back(r2[j], order[pos[j]]);
     }
   }
-  const size_t want = std::min(static_cast<size_t>(k), pairs.size());
-  if (want == 0)
+  const size_t want = static_cast<size_t>(k);
+  if (pairs.size() < want || want == 0)
   {
-    kth = 0.0;
-    return;
+    return false;
   }
   std::nth_element(pairs.begin(), pairs.begin() + (want - 1), pairs.end());
   kth = std::sqrt(pairs[want - 1].first);
@@ -118,6 +186,53 @@ void NearestOfList(const std::vector<Index>& pos, const std::vector<double>& r2,
   for (size_t j = 0; j < kept; ++j)
   {
     row[j] = static_cast<std::int32_t>(pairs[j].second);
+  }
+  return true;
+}
+
+/// Outliers: points alone in their surroundings, and points farther from their neighbourhood's quadric than
+/// six times the median such distance
+/// (about 4 sigma for Gaussian noise) and than 5 % of the neighbourhood radius (the floor for exact data,
+/// above the quadric's own O(kappa^3 R^4) misfit).
+void FlagOutliers(NormalField& field)
+{
+  std::vector<double> residuals, distances;
+  const size_t n = field.Valid.size();
+  for (size_t i = 0; i < n; ++i)
+  {
+    if (field.Valid[i])
+    {
+      residuals.push_back(field.Residual[i]);
+      distances.push_back(field.NeighborDistance[i]);
+    }
+  }
+  const double threshold = std::max(6.0 * Median(residuals), 0.05 * Median(distances));
+  const int k = field.GraphDegree;
+  for (size_t i = 0; i < n; ++i)
+  {
+    if (!field.Valid[i])
+    {
+      continue;
+    }
+    // Isolated: its k-th neighbour three times farther than its nearest neighbours' (a sparse region of a
+    // scan has sparse neighbours too, so only points alone in their surroundings qualify).
+    double around = 0.0;
+    int counted = 0;
+    for (int j = 0; j < k; ++j)
+    {
+      const std::int32_t v = field.Graph[i * k + j];
+      if (v >= 0)
+      {
+        around += field.NeighborDistance[v];
+        ++counted;
+      }
+    }
+    const bool isolated = counted > 0 && field.NeighborDistance[i] > 3.0 * around / counted;
+    if (isolated || field.Residual[i] > threshold)
+    {
+      field.Outlier[i] = 1;
+      ++field.OutlierCount;
+    }
   }
 }
 
@@ -151,13 +266,12 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
     {
       const Index s = j * nv / samples;
       const double* x = sorted + 3 * s;
-      // k + 1: the point finds itself first.
-      const int found = grid.FindKNearest(x, k + 1, ids, d2);
-      if (found < 4)
+      const int found = NearestDistinct(grid, x, k, ids, d2, kth[j]);
+      if (found < 4 || !(kth[j] > 0.0))
       {
+        kth[j] = 0.0;
         continue;
       }
-      kth[j] = std::sqrt(d2[found - 1]);
       grid.FindWithinRadiusPositions(x, kth[j], pos, d2);
       const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, kth[j]);
       spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
@@ -208,6 +322,9 @@ bool EstimateNormals(
   field.Normals.assign(static_cast<size_t>(3 * n), 0.0);
   field.Radii.assign(static_cast<size_t>(n), 0.0);
   field.NeighborDistance.assign(static_cast<size_t>(n), 0.0);
+  field.Residual.assign(static_cast<size_t>(n), 0.0);
+  field.Outlier.assign(static_cast<size_t>(n), 0);
+  field.OutlierCount = 0;
   field.SurfaceVariation.assign(static_cast<size_t>(n), 0.0);
   field.Valid.assign(static_cast<size_t>(n), 0);
   field.Graph.assign(static_cast<size_t>(n * degree), -1);
@@ -254,22 +371,17 @@ bool EstimateNormals(
           grid.FindWithinRadiusPositions(x, first, pos, r2);
         }
         double radius = first;
-        if (first > 0.0 && pos.size() > static_cast<size_t>(k))
+        if (!(first > 0.0 && NearestOfList(pos, r2, k, order, row, degree, field.NeighborDistance[id], pairs)))
         {
-          NearestOfList(pos, r2, s, k, order, row, degree, field.NeighborDistance[id], pairs);
-        }
-        else
-        {
-          const int found = grid.FindKNearest(x, k + 1, ids, d2);
+          const int found = NearestDistinct(grid, x, k, ids, d2, field.NeighborDistance[id]);
           int kept = 0;
           for (int j = 0; j < found && kept < degree; ++j)
           {
-            if (ids[j] != id)
+            if (d2[j] > 0.0)
             {
               row[kept++] = static_cast<std::int32_t>(ids[j]);
             }
           }
-          field.NeighborDistance[id] = found > 0 ? std::sqrt(d2[found - 1]) : 0.0;
           if (!fixed)
           {
             radius = std::max(field.NeighborDistance[id], noiseRadius);
@@ -286,6 +398,7 @@ bool EstimateNormals(
         {
           field.Normals[3 * id + a] = pca.Normal[a];
         }
+        field.Residual[id] = pca.Residual;
         const double total = pca.Eigenvalues[0] + pca.Eigenvalues[1] + pca.Eigenvalues[2];
         field.SurfaceVariation[id] = total > 0.0 ? pca.Eigenvalues[0] / total : 0.0;
         field.Radii[id] = radius;
@@ -296,7 +409,42 @@ bool EstimateNormals(
     aborted = progress && !progress(static_cast<double>(end) / static_cast<double>(nv));
   }
   field.InvalidCount = invalid;
+  if (!aborted)
+  {
+    FlagOutliers(field);
+  }
   return !aborted && invalid < n;
+}
+
+std::vector<double> FitSupports(
+  const NormalField& field, double supportScale, double noiseScale, bool fixedRadius, double& median)
+{
+  const size_t n = field.Radii.size();
+  std::vector<double> support(n, 0.0);
+  for (size_t i = 0; i < n; ++i)
+  {
+    if (!(field.Radii[i] > 0.0) || field.Outlier[i])
+    {
+      continue;
+    }
+    support[i] = fixedRadius ? supportScale * field.Radii[i]
+                             : std::max(supportScale * field.NeighborDistance[i], noiseScale * field.Scale.Radius);
+  }
+  std::vector<double> positive;
+  positive.reserve(n);
+  for (double r : support)
+  {
+    if (r > 0.0)
+    {
+      positive.push_back(r);
+    }
+  }
+  median = Median(positive);
+  for (double& r : support)
+  {
+    r = std::min(r, 3.0 * median);
+  }
+  return support;
 }
 
 } // namespace meshfree

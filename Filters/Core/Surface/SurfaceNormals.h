@@ -18,7 +18,14 @@
  * SupportRadius > 0 replaces all of this with one fixed radius.
  *
  * Invalid normals (zero vector, Valid 0): points with NaN/Inf coordinates, and points whose neighbourhood
- * has fewer than 3 points or is collinear (l1 ~ 0).
+ * has fewer than 3 points or is collinear (l1 ~ 0). Exact duplicates of a point do not count as its
+ * neighbours (they would shrink r_k without adding any sampling).
+ *
+ * Outliers: a point whose r_k is over 3 x the mean r_k of its nearest neighbours (alone in its surroundings;
+ * a sparse region of a scan has sparse neighbours too), or farther from the quadric fitted to its neighbourhood
+ * than 6 x the median of that distance
+ * (about 4 sigma for Gaussian noise; with a floor of 5 % of the radius for exact data) keeps its normal but is
+ * flagged, and the implicit fits leave it out (FitSupports gives it no support).
  */
 #ifndef meshfree_SurfaceNormals_h
 #define meshfree_SurfaceNormals_h
@@ -55,11 +62,14 @@ struct NormalField
   std::vector<double> Radii;            // neighbourhood radius used at each point: max(r_k, noise radius)
   std::vector<double> NeighborDistance; // r_k: distance to the NeighborCount-th nearest other point
   std::vector<double> SurfaceVariation; // l0 / (l0 + l1 + l2)
+  std::vector<double> Residual;         // distance from the point to its neighbourhood's fitted quadric
+  std::vector<unsigned char> Outlier;   // residual > max(6 x median residual, 5 % of r_k): left out of fits
   std::vector<unsigned char> Valid;
   std::vector<std::int32_t> Graph;      // GraphDegree nearest other points per point (-1 pads)
   int GraphDegree = 0;
   CloudScale Scale;
   Index InvalidCount = 0;
+  Index OutlierCount = 0;
 };
 
 /// Normals of the points the grid was built over (grid.NumberOfPoints(), in their original order). Returns
@@ -69,6 +79,13 @@ bool EstimateNormals(const NeighborGrid& grid, const NormalOptions& options, Nor
 
 /// The scale of the cloud (also computed by EstimateNormals): spacing, noise and the radius noise asks for.
 CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& options);
+
+/// Support radii of the implicit fits over an estimated field: supportScale x r_k (bridges the gaps of
+/// random sampling) but at least noiseScale x the noise radius (averages the noise), or supportScale x the
+/// fixed radius when one was given; 0 for invalid points. Capped at three times their median, so that a few
+/// isolated points (outliers, the noise's tails) do not widen every neighbour query. `median` receives it.
+std::vector<double> FitSupports(
+  const NormalField& field, double supportScale, double noiseScale, bool fixedRadius, double& median);
 
 } // namespace meshfree
 

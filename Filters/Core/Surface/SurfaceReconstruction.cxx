@@ -5,6 +5,7 @@
 #include "Surface/FluidSurface.h"
 #include "Surface/PatchSurface.h"
 #include "Surface/PointSetSurface.h"
+#include "Surface/UniqueCloud.h"
 
 #include <algorithm>
 #include <chrono>
@@ -30,18 +31,6 @@ const char* SurfaceMethodName(SurfaceMethod method)
 
 namespace
 {
-double Median(std::vector<double> v)
-{
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !(x > 0.0); }), v.end());
-  if (v.empty())
-  {
-    return 0.0;
-  }
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
-
 /// A sub-range [begin, end) of the progress scale.
 ProgressCallback Stage(const ProgressCallback& progress, double begin, double end)
 {
@@ -52,15 +41,22 @@ ProgressCallback Stage(const ProgressCallback& progress, double begin, double en
   return [progress, begin, end](double f) { return progress(begin + (end - begin) * f); };
 }
 
-/// Unit normals from the input; a point without a usable one gets radius 0 (ignored by the fits).
+/// Unit normals from the input. A point with finite coordinates and a usable normal takes part even where
+/// its neighbourhood gave no PCA plane; one without a usable normal is ignored (radius 0). Returns how many
+/// points with finite coordinates had no usable normal.
 Index TakeNormals(const SurfaceInput& input, NormalField& field)
 {
   Index missing = 0;
   for (Index i = 0; i < input.Count; ++i)
   {
+    const double* p = input.Points + 3 * i;
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    {
+      continue;
+    }
     const double* n = input.Normals + 3 * i;
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(len > 0.0) || !std::isfinite(len) || !field.Valid[i])
+    if (!(len > 0.0) || !std::isfinite(len))
     {
       field.Radii[i] = 0.0;
       field.Valid[i] = 0;
@@ -71,6 +67,11 @@ Index TakeNormals(const SurfaceInput& input, NormalField& field)
     {
       field.Normals[3 * i + a] = n[a] / len;
     }
+    if (!field.Valid[i] && field.NeighborDistance[i] > 0.0)
+    {
+      field.Radii[i] = std::max(field.NeighborDistance[i], field.Scale.Radius);
+    }
+    field.Valid[i] = field.Radii[i] > 0.0 ? 1 : 0;
   }
   return missing;
 }
@@ -105,7 +106,7 @@ void ChooseLattice(const NeighborGrid& grid, double cell, double margin, Contour
 
 /// Seed cells of the continuation: per occupied block of 4^3 lattice cells, its first chosen point is moved
 /// onto the surface (a few projection steps, at most `reach` away) and the cell it lands in is a seed; a point
-/// that cannot be projected seeds its own cell. Every piece of surface near the data gets many seeds, yet
+/// that cannot be projected seeds nothing. Every piece of surface near the data gets many seeds, yet
 /// only the cells the surface crosses are evaluated (seeding every occupied cell would evaluate the whole
 /// noisy shell of points, several cells thick).
 std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitField& field, const ContourOptions& lattice,
@@ -141,10 +142,18 @@ std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitFie
     for (Index b = 0; b < count; ++b)
     {
       double x[3], n[3];
-      std::copy(sorted + 3 * blocks[b].second, sorted + 3 * blocks[b].second + 3, x);
-      field.Project(x, n, reach, 3, scratch);
+      const double* p = sorted + 3 * blocks[b].second;
+      std::copy(p, p + 3, x);
+      bool projected = field.Project(x, n, reach, 3, scratch);
+      if (!projected)
+      {
+        // A flat field at the point (the centre of a lone droplet): try once from a quarter reach aside.
+        const double aside[3] = { p[0] + 0.25 * reach, p[1], p[2] };
+        std::copy(aside, aside + 3, x);
+        projected = field.Project(x, n, reach, 3, scratch);
+      }
       Index c[3];
-      if (SparseContour::CellOf(x, lattice, c))
+      if (projected && SparseContour::CellOf(x, lattice, c))
       {
         seeds[b] = SparseContour::CellKey(c[0], c[1], c[2]);
         ok[b] = 1;
@@ -290,6 +299,17 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   {
     return true;
   }
+  // Point-set surfaces work on the distinct points (UniqueCloud.h); particles keep their duplicates' mass.
+  UniqueCloud unique;
+  SurfaceInput distinct = input;
+  if (options.Method != SurfaceMethod::SPH && MergeDuplicates(grid, input.Points, input.Normals, unique))
+  {
+    report.Duplicates = unique.Duplicates;
+    distinct.Points = unique.Points.data();
+    distinct.Count = static_cast<Index>(unique.Points.size() / 3);
+    distinct.Normals = input.Normals ? unique.Normals.data() : nullptr;
+    grid.Build(distinct.Points, distinct.Count);
+  }
 
   std::unique_ptr<ImplicitField> field;
   std::vector<std::uint64_t> seeds;
@@ -313,10 +333,17 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     }
     margin = 2.0 * fluid->SupportRadius();
     ChooseLattice(grid, cell, margin, lattice, report.CellSizeEnlarged);
+    // Seeds from the particles near the free surface (all of them when none is, e.g. a single particle).
     std::vector<unsigned char> near(static_cast<size_t>(input.Count), 0);
+    bool any = false;
     for (Index i = 0; i < input.Count; ++i)
     {
       near[i] = fluid->NearSurface(i) ? 1 : 0;
+      any = any || near[i];
+    }
+    if (!any)
+    {
+      std::fill(near.begin(), near.end(), 1);
     }
     seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near);
     field = std::move(fluid);
@@ -339,39 +366,19 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       return false;
     }
     report.Scale = normals.Scale;
-    if (input.Normals)
+    if (distinct.Normals)
     {
-      report.PointsWithoutNormal = TakeNormals(input, normals) - report.InvalidPoints;
+      report.PointsWithoutNormal = TakeNormals(distinct, normals);
     }
     else
     {
       report.NormalsEstimated = true;
       std::vector<double> confidence;
       report.Orientation = OrientNormals(grid, normals, OrientationOptions(), confidence);
-      report.PointsWithoutNormal = normals.InvalidCount - report.InvalidPoints;
+      report.PointsWithoutNormal = normals.InvalidCount - grid.NumberOfInvalidPoints();
     }
-    // The fits' support: SupportScale x r_k bridges the gaps of random sampling; where the noise asks for a
-    // wider neighbourhood, NoiseScale x that radius averages the noise (both are in SurfaceOptions).
-    std::vector<double> support(normals.Radii);
-    for (Index i = 0; i < input.Count; ++i)
-    {
-      if (support[i] > 0.0 && !(options.SupportRadius > 0.0))
-      {
-        support[i] = std::max(options.SupportScale * normals.NeighborDistance[i], options.NoiseScale * normals.Scale.Radius);
-      }
-      else
-      {
-        support[i] *= options.SupportScale;
-      }
-    }
-    report.SupportRadius = Median(support);
-    // Isolated points (outliers, the tails of the noise) have a far k-th neighbour; one huge support would
-    // widen every neighbour query of the fits (their radius is the largest support), so supports are capped
-    // at three times the median.
-    for (double& r : support)
-    {
-      r = std::min(r, 3.0 * report.SupportRadius);
-    }
+    std::vector<double> support = FitSupports(
+      normals, options.SupportScale, options.NoiseScale, options.SupportRadius > 0.0, report.SupportRadius);
     if (!(cell > 0.0))
     {
       // A quarter of the fits' support (finer detail than that the fit cannot represent), but not below 1.5
@@ -396,7 +403,13 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       patches->SetCloud(grid, normals.Normals.data(), support.data());
       field = std::move(patches);
     }
-    seeds = SeedCells(grid, *field, lattice, report.SupportRadius, normals.Valid);
+    std::vector<unsigned char> seeding(normals.Valid);
+    for (size_t i = 0; i < seeding.size(); ++i)
+    {
+      seeding[i] = seeding[i] && !normals.Outlier[i] && support[i] > 0.0;
+    }
+    report.Outliers = normals.OutlierCount;
+    seeds = SeedCells(grid, *field, lattice, report.SupportRadius, seeding);
     if (progress && !progress(0.2))
     {
       report.Aborted = true;

@@ -71,8 +71,10 @@ struct SurfaceReport
 {
   Index InputPoints = 0;
   Index InvalidPoints = 0;      // NaN/Inf coordinates
+  Index Duplicates = 0;         // MLS/WLS: exact duplicates merged (UniqueCloud.h)
   Index PointsWithoutNormal = 0; // MLS/WLS: no valid normal (given or estimated); ignored by the fits
   bool NormalsEstimated = false;
+  Index Outliers = 0;           // MLS/WLS: points left out of the fits (see SurfaceNormals.h)
   OrientationReport Orientation;
   CloudScale Scale;             // MLS/WLS: spacing, noise, noise radius
   double CellSize = 0.0;        // used
