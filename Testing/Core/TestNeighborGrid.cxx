@@ -824,3 +824,27 @@ TEST(NeighborGrid, AllPointsRadiusListsInParallelAndDegenerateInput)
   EXPECT_TRUE(rows.empty());
 }
 } // namespace
+
+TEST(NeighborGrid, FindDuplicatesGroupsEqualCoordinatesOnly)
+{
+  // Points 0, 3 and 5 coincide; 1 and 4 coincide; 2 differs from 1 in the last bit; 6 is NaN.
+  const double x = 0.1 + 0.2;
+  const double next = std::nextafter(x, 1.0);
+  const std::vector<double> p = { 1, 2, 3, x, 0, 0, next, 0, 0, 1, 2, 3, x, 0, 0, 1, 2, 3,
+    std::numeric_limits<double>::quiet_NaN(), 0, 0 };
+  NeighborGrid grid;
+  grid.Build(p.data(), 7);
+  std::vector<Index> rep;
+  EXPECT_EQ(grid.FindDuplicates(rep), 3);
+  const std::vector<Index> expected = { 0, 1, 2, 0, 1, 0, -1 };
+  EXPECT_EQ(rep, expected);
+  // A million copies of one point fall into one cell: still linear-logarithmic, one group.
+  std::vector<double> same(3000000, 0.5);
+  grid.Build(same.data(), 1000000);
+  EXPECT_EQ(grid.FindDuplicates(rep), 999999);
+  EXPECT_EQ(*std::max_element(rep.begin(), rep.end()), 0);
+  // No valid point at all.
+  grid.Build(p.data() + 18, 1);
+  EXPECT_EQ(grid.FindDuplicates(rep), 0);
+  EXPECT_EQ(rep, std::vector<Index>{ -1 });
+}

@@ -95,6 +95,25 @@ TEST(SurfaceHostile, EmptyOneAndCollinear)
   }
 }
 
+TEST(SurfaceHostile, NoFinitePoint)
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> p = { nan, 0.0, 0.0, 1.0, nan, 0.0, 0.0, 0.0, std::numeric_limits<double>::infinity() };
+  for (SurfaceMethod m : AllMethods)
+  {
+    SurfaceReport report;
+    EXPECT_EQ(Reconstruct(p, m, &report).NumberOfTriangles(), 0);
+    EXPECT_EQ(report.InvalidPoints, 3);
+  }
+  CloudNormalsResult r;
+  ComputeCloudNormals(p.data(), 3, nullptr, CloudNormalsOptions(), r);
+  EXPECT_EQ(r.Invalid, 3);
+  for (double v : r.Normals)
+  {
+    EXPECT_EQ(v, 0.0);
+  }
+}
+
 TEST(SurfaceHostile, FlatDiscIsAnOpenSheetInItsPlane)
 {
   std::vector<double> disc;

@@ -1004,6 +1004,10 @@ void NeighborGrid::FindWithinRadius(
 Index NeighborGrid::FindDuplicates(std::vector<Index>& representative) const
 {
   representative.assign(static_cast<size_t>(this->NumberOfInputPoints), -1);
+  if (this->Order.empty())
+  {
+    return 0; // no valid point: no cell ranges either
+  }
   const Index cells = this->GridDims[0] * this->GridDims[1] * this->GridDims[2];
   const CellRange* ranges = this->CellRanges.data();
   const double* xyz = this->Sorted.data();

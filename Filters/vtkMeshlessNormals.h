@@ -1,0 +1,113 @@
+/**
+ * @class   vtkMeshlessNormals
+ * @brief   oriented normals and curvature of a point cloud, optionally moved onto its MLS surface
+ *          (ParaView "Meshless Normals")
+ *
+ * Input port 0 is a point cloud (vtkPointSet). The output is the input (shallow copy) with the point arrays
+ * - `Normals`: unit, consistently oriented (outward on a closed object); also the active normals;
+ * - `Curvature`: mean curvature of the algebraic sphere fitted at the point, 1 / length, positive where the
+ *   surface is convex with respect to the normals;
+ * - `SurfaceVariation`: l0 / (l0 + l1 + l2) of the neighbourhood's PCA (0 on a plane, 1/3 for isotropic scatter);
+ * - `OrientationConfidence`: how unambiguous the orientation was (below 0.5: ambiguous);
+ * - `vtkValidPointMask`: 0 where no normal could be computed (NaN/Inf coordinates, degenerate
+ *   neighbourhood); Normals, Curvature and the others are 0 there.
+ * With ProjectPoints on, the points are moved onto the MLS (algebraic point-set) surface, which removes
+ * noise along the normal; normals and curvature are then those at the moved points.
+ *
+ * Normals are the PCA normals (Hoppe et al. 1992) over a neighbourhood of at least NeighborCount points,
+ * widened where the cloud's noise asks for it (SupportRadius > 0 fixes the radius). Orientation:
+ * - Auto (default): like InputNormals when the input has a 3-component point array `Normals`, else Propagation;
+ * - Propagation: a minimum spanning tree over the neighbour graph, each connected piece then turned outward;
+ * - Viewpoint: as Propagation, each piece then turned towards Viewpoint (a scanner's position);
+ * - InputNormals: each normal flipped to agree with the input's `Normals` (an error when there are none).
+ * Details in Filters/Core/Surface/CloudNormals.h.
+ *
+ * Field data: `NoiseEstimate` (spread of the points about the surface), `SupportRadius` (median
+ * neighbourhood radius), `AmbiguousOrientations` (points with OrientationConfidence < 0.5).
+ *
+ * @sa vtkMeshlessSurface vtkPCANormalEstimation
+ */
+#ifndef vtkMeshlessNormals_h
+#define vtkMeshlessNormals_h
+
+#include "MeshFreeFiltersModule.h"
+#include "vtkPointSetAlgorithm.h"
+
+class MESHFREEFILTERS_EXPORT vtkMeshlessNormals : public vtkPointSetAlgorithm
+{
+public:
+  static vtkMeshlessNormals* New();
+  vtkTypeMacro(vtkMeshlessNormals, vtkPointSetAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum Orientations
+  {
+    AUTO = 0,
+    PROPAGATION = 1,
+    VIEWPOINT = 2,
+    INPUT_NORMALS = 3
+  };
+
+  ///@{
+  /**
+   * The smallest neighbourhood of every point: its NeighborCount nearest other points, widened where the
+   * noise asks for more. Default 20.
+   */
+  vtkSetClampMacro(NeighborCount, int, 3, 1000);
+  vtkGetMacro(NeighborCount, int);
+  ///@}
+
+  ///@{
+  /// When > 0, one fixed neighbourhood radius for every point, in data units. Default 0: automatic.
+  vtkSetClampMacro(SupportRadius, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(SupportRadius, double);
+  ///@}
+
+  ///@{
+  /// How the normals' signs are chosen: Auto (default), Propagation, Viewpoint or InputNormals.
+  vtkSetClampMacro(Orientation, int, AUTO, INPUT_NORMALS);
+  vtkGetMacro(Orientation, int);
+  void SetOrientationToAuto() { this->SetOrientation(AUTO); }
+  void SetOrientationToPropagation() { this->SetOrientation(PROPAGATION); }
+  void SetOrientationToViewpoint() { this->SetOrientation(VIEWPOINT); }
+  void SetOrientationToInputNormals() { this->SetOrientation(INPUT_NORMALS); }
+  ///@}
+
+  ///@{
+  /// The point the normals face with Orientation Viewpoint (default 0, 0, 0).
+  vtkSetVector3Macro(Viewpoint, double);
+  vtkGetVector3Macro(Viewpoint, double);
+  ///@}
+
+  ///@{
+  /// Move the points onto their MLS surface (default off).
+  vtkSetMacro(ProjectPoints, bool);
+  vtkGetMacro(ProjectPoints, bool);
+  vtkBooleanMacro(ProjectPoints, bool);
+  ///@}
+
+  ///@{
+  /// Refits of the projection (default 2); more converge closer to the surface, at more cost.
+  vtkSetClampMacro(ProjectionIterations, int, 1, 100);
+  vtkGetMacro(ProjectionIterations, int);
+  ///@}
+
+protected:
+  vtkMeshlessNormals();
+  ~vtkMeshlessNormals() override = default;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int NeighborCount = 20;
+  double SupportRadius = 0.0;
+  int Orientation = AUTO;
+  double Viewpoint[3] = { 0.0, 0.0, 0.0 };
+  bool ProjectPoints = false;
+  int ProjectionIterations = 2;
+
+private:
+  vtkMeshlessNormals(const vtkMeshlessNormals&) = delete;
+  void operator=(const vtkMeshlessNormals&) = delete;
+};
+
+#endif

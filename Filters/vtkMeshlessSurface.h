@@ -1,0 +1,167 @@
+/**
+ * @class   vtkMeshlessSurface
+ * @brief   triangle mesh of the surface a point cloud or a particle fluid samples (ParaView "Meshless Surface")
+ *
+ * Input port 0 (`Input`) is a point cloud or a set of SPH particles (vtkPointSet). The output is a
+ * vtkPolyData of triangles, closed where the sampled object is closed, with the point array `Normals` (unit,
+ * outward; also the active normals) and every other numeric point array of the input approximated at the
+ * vertices (same names, every component, as double).
+ *
+ * Methods (details in Filters/Core/Surface/SurfaceReconstruction.h):
+ * - MLS (default): the algebraic point-set surface (APSS: a sphere fitted at every point of space) of the
+ *   oriented cloud.
+ * - WLS: a partition of unity of local weighted least-squares fits (Ohtake's multi-level partition of unity).
+ * - SPH: the level SurfaceLevel of the particles' colour field sum_j V_j W(x - x_j, H), with volumes
+ *   V_j = Mass / Density when both arrays exist; AnisotropicKernels stretches the kernels along the local
+ *   particle distribution (Yu & Turk 2013), keeping flat free surfaces flat.
+ * For MLS and WLS the input's point array `Normals` (3 components) orients the fits when UseInputNormals is
+ * on; otherwise normals are estimated by PCA over a neighbourhood adapted to density and noise and oriented
+ * outward by a minimum-spanning-tree propagation.
+ *
+ * Scales: NeighborCount sets the smallest neighbourhood of every point (SupportRadius > 0 fixes its radius
+ * instead); the implicit fits use SupportScale times it; CellSize (0 = automatic: 1.5 sample spacings or a
+ * quarter of the fits' support, or half the particle spacing for SPH) is the contouring lattice's spacing. The zero set is contoured only in
+ * the cells it passes through, and the vertices are then projected onto the surface (ProjectVertices).
+ *
+ * The other point arrays are approximated at the vertices by MLS of degree 1 over the NeighborCount nearest
+ * input points (meshfree::Approximator, with its fallbacks: wider support, then Shepard); for MLS and WLS each
+ * component is kept within the range of its input values (a linear fit would overshoot where the surface
+ * bridges a gap in the data; a fluid's surface stays within a kernel radius of its particles). A vertex where
+ * even the fallbacks fail gets 0 and 0 in `vtkValidPointMask`, which is added whenever arrays are
+ * approximated. No NaN is ever written.
+ *
+ * Field data: `SurfaceMethod` (text), `CellSize`, `SupportRadius` (median fit support, or the SPH kernel
+ * radius H) and the stages' wall-clock seconds (`SetupSeconds`, `ContourSeconds`, `ProjectionSeconds`,
+ * `ApproximationSeconds`).
+ *
+ * @sa vtkMeshlessNormals vtkMeshlessApproximation vtkSurfaceReconstructionFilter
+ */
+#ifndef vtkMeshlessSurface_h
+#define vtkMeshlessSurface_h
+
+#include "MeshFreeFiltersModule.h"
+#include "vtkPolyDataAlgorithm.h"
+
+class vtkPointSet;
+
+class MESHFREEFILTERS_EXPORT vtkMeshlessSurface : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkMeshlessSurface* New();
+  vtkTypeMacro(vtkMeshlessSurface, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum Methods
+  {
+    MLS = 0,
+    WLS = 1,
+    SPH = 2
+  };
+
+  ///@{
+  /// Surface definition: MLS point-set surface (default), WLS partition of unity, or SPH colour field.
+  vtkSetClampMacro(Method, int, MLS, SPH);
+  vtkGetMacro(Method, int);
+  void SetMethodToMLS() { this->SetMethod(MLS); }
+  void SetMethodToWLS() { this->SetMethod(WLS); }
+  void SetMethodToSPH() { this->SetMethod(SPH); }
+  ///@}
+
+  ///@{
+  /**
+   * The smallest neighbourhood of every point: its NeighborCount nearest other points (MLS, WLS), widened
+   * where the noise asks for more; also the neighbours of the vertices' array approximation. Default 20.
+   */
+  vtkSetClampMacro(NeighborCount, int, 3, 1000);
+  vtkGetMacro(NeighborCount, int);
+  ///@}
+
+  ///@{
+  /**
+   * When > 0, one fixed neighbourhood radius for every point (MLS, WLS) or the kernel radius H (SPH), in
+   * data units. Default 0: automatic, from NeighborCount and the noise (MLS, WLS) or the particle spacing (SPH).
+   */
+  vtkSetClampMacro(SupportRadius, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(SupportRadius, double);
+  ///@}
+
+  ///@{
+  /**
+   * Spacing of the contouring lattice, in data units. Default 0: automatic (about the sample spacing for
+   * MLS and WLS, half the particle spacing for SPH); enlarged, with a warning, when the lattice would be too big.
+   */
+  vtkSetClampMacro(CellSize, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(CellSize, double);
+  ///@}
+
+  ///@{
+  /**
+   * MLS, WLS: support of the implicit fits relative to the neighbourhood radius (default 2). Larger bridges
+   * wider gaps of the sampling and smooths more; too small leaves holes.
+   */
+  vtkSetClampMacro(SupportScale, double, 1.0, 100.0);
+  vtkGetMacro(SupportScale, double);
+  ///@}
+
+  ///@{
+  /**
+   * SPH: level of the colour field (0 outside, 1 inside the fluid) that is the surface; must lie strictly
+   * between 0 and 1 (values outside give an error). Default 0.5, which encloses the particles' volume.
+   */
+  vtkSetClampMacro(SurfaceLevel, double, 0.0, 1.0);
+  vtkGetMacro(SurfaceLevel, double);
+  ///@}
+
+  ///@{
+  /// SPH: anisotropic kernels that follow the particles' local distribution (default off).
+  vtkSetMacro(AnisotropicKernels, bool);
+  vtkGetMacro(AnisotropicKernels, bool);
+  vtkBooleanMacro(AnisotropicKernels, bool);
+  ///@}
+
+  ///@{
+  /// Move the contour's vertices onto the implicit surface (default on); off leaves them on the lattice's edges.
+  vtkSetMacro(ProjectVertices, bool);
+  vtkGetMacro(ProjectVertices, bool);
+  vtkBooleanMacro(ProjectVertices, bool);
+  ///@}
+
+  ///@{
+  /**
+   * MLS, WLS: use the input's 3-component point array `Normals` when present (default on); off (or without
+   * that array) estimates and orients normals from the points alone.
+   */
+  vtkSetMacro(UseInputNormals, bool);
+  vtkGetMacro(UseInputNormals, bool);
+  vtkBooleanMacro(UseInputNormals, bool);
+  ///@}
+
+protected:
+  vtkMeshlessSurface();
+  ~vtkMeshlessSurface() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int Method = MLS;
+  int NeighborCount = 20;
+  double SupportRadius = 0.0;
+  double CellSize = 0.0;
+  double SupportScale = 2.0;
+  double SurfaceLevel = 0.5;
+  bool AnisotropicKernels = false;
+  bool ProjectVertices = true;
+  bool UseInputNormals = true;
+
+private:
+  vtkMeshlessSurface(const vtkMeshlessSurface&) = delete;
+  void operator=(const vtkMeshlessSurface&) = delete;
+
+  struct Cloud;
+  struct Result;
+  void GatherInput(vtkPointSet* input, Cloud& cloud);
+  void ReportReconstruction(const Cloud& cloud, const Result& result);
+  void AddApproximatedArrays(vtkPointSet* input, const Cloud& cloud, vtkPolyData* output, Result& result);
+};
+
+#endif
