@@ -1,6 +1,7 @@
 """The demo scripts of Data/Scripts that the README's demo command runs besides the figures run headless
-and write their pictures: demo.py (kernel profiles and surface, neighbour cloud) and demo_solid.py (the
-deformable scenes of ch. 4). demo_dambreak.py (65,536 SPH particles, minutes) is the SPH suite's."""
+and write their pictures: demo.py (kernel profiles and surface, neighbour cloud), demo_solid.py (the
+deformable scenes of ch. 4) and demo_scan.py (the shipped scan's normals and surface). demo_dambreak.py
+(65,536 SPH particles, minutes) is the SPH suite's."""
 import os
 import sys
 
@@ -11,3 +12,4 @@ scripts = os.path.dirname(figure_run.FIGURES)
 figure_run.run("demo", "demo.py", [], ["kernels.png", "kernel_wendland.png", "neighbors.png"], folder=scripts)
 figure_run.run("demo_solid", "demo_solid.py", [],
                ["solid_octahedron.png", "solid_ellipsoid568.png", "solid_ellipsoid715.png"], folder=scripts)
+figure_run.run("demo_scan", "demo_scan.py", [], ["scan_points.png", "scan_surface.png"], folder=scripts)
