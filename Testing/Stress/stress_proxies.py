@@ -1,5 +1,5 @@
 """Stress through paraview.simple: hostile clouds written as .xyz/.pcd files, opened with OpenDataFile and fed
-to every MeshFree filter with every enumeration text; the sources stepped over all their time steps with
+to every MeshFree filter (approximation, neighbours, surface, normals) with every enumeration text; the sources stepped over all their time steps with
 extreme settings; malformed files opened in ParaView. Each case: no crash, no NaN/Inf in any fetched point
 or array, the expected message in VTK's output (captured with a vtkStringOutputWindow), a defined result."""
 import math
@@ -177,6 +177,33 @@ for name, pts in clouds.items():
     check(counts is not None and counts.GetRange()[0] == data.GetNumberOfPoints() - 1,
           "a radius covering the cloud does not count every other point")
     simple.Delete(n)
+    # Surface reconstruction and normals: every method and orientation, absurd supports.
+    for method in ["MLS", "WLS", "SPH"]:
+        for support in [0.0, 1e300]:
+            begin("%s MeshlessSurface %s SupportRadius %g" % (name, method, support))
+            f = MeshlessSurface(Input=reader, Method=method, NeighborCount=1000, SupportRadius=support,
+                                AnisotropicKernels=1 if method == "SPH" else 0)
+            data = fetch(f)
+            check(data is not None, "no output")
+            check_finite(data)
+            expect_no_error()
+            if name == "nan-values" and data.GetNumberOfPoints() > 0:
+                expect_message("NaN/Inf")
+            simple.Delete(f)
+    for orientation in ["Auto", "Propagation", "Viewpoint"]:
+        begin("%s MeshlessNormals %s" % (name, orientation))
+        f = MeshlessNormals(Input=reader, Orientation=orientation, ProjectPoints=1, NeighborCount=1000)
+        data = fetch(f)
+        check(data is not None and data.GetNumberOfPoints() == len(pts), "not every point in the output")
+        # The input's own arrays pass through as they are (NaN values included): check what the filter adds.
+        check_finite(data, only=("Normals", "Curvature", "SurfaceVariation", "OrientationConfidence"))
+        expect_no_error()
+        simple.Delete(f)
+    begin(name + " MeshlessNormals InputNormals without Normals")
+    f = MeshlessNormals(Input=reader, Orientation="InputNormals")
+    fetch(f)
+    expect_message("Normals")
+    simple.Delete(f)
     simple.Delete(reader)
 
 # The kernel source: every kernel by its text, extreme supports.

@@ -75,10 +75,11 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
     this->H = extent > 0.0 ? extent : 1.0;
   }
 
-  // Number densities sum_k W(|x_j - x_k|, H) (the particle itself included).
+  // Number densities sum_k W(|x_j - x_k|, H) (the particle itself included), and every volume, in units of
+  // H^3: with a kernel radius of 1e300 (or particles at 1e-300) H^3 and 1/H^3 leave double's range, the
+  // ratios do not.
   std::vector<double> density(static_cast<size_t>(nv), 0.0);
   const double invH = 1.0 / this->H;
-  const double invH3 = invH * invH * invH;
 #pragma omp parallel
   {
     std::vector<Index> pos;
@@ -92,24 +93,26 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
       {
         sum += this->Unit.ValueSquared(r2 * invH * invH);
       }
-      density[s] = sum * invH3;
+      density[s] = sum;
     }
   }
   const double bulk = Median(density);
-  const double v0 = bulk > 0.0 ? 1.0 / bulk : std::pow(this->H * 0.5, 3);
-  this->ParticleSpacing = std::cbrt(v0);
+  const double v0 = bulk > 0.0 ? 1.0 / bulk : 0.125; // relative to H^3
+  this->ParticleSpacing = this->H * std::cbrt(v0);
   this->Volumes.assign(static_cast<size_t>(nv), v0);
+  double total = 0.0;
   for (Index s = 0; s < nv; ++s)
   {
     const Index id = order[s];
     if (volumes && volumes[id] > 0.0 && std::isfinite(volumes[id]))
     {
-      this->Volumes[s] = volumes[id];
+      this->Volumes[s] = volumes[id] * invH * invH * invH;
     }
-    this->Volume += this->Volumes[s];
+    total += this->Volumes[s];
     const double colour = density[s] * v0;
     this->Boundary[id] = colour < 0.9 || colour > 1.1 ? 1 : 0;
   }
+  this->Volume = total * this->H * this->H * this->H;
   this->QueryRadius = this->H;
   if (!options.Anisotropic)
   {
@@ -199,7 +202,6 @@ bool FluidSurface::Evaluate(const double x[3], double& value, double gradient[3]
   }
   this->Grid->FindWithinRadiusPositions(x, this->QueryRadius, s.Positions, s.Dist2);
   const double invH = 1.0 / this->H;
-  const double invH3 = invH * invH * invH;
   double c = 0.0, g[3] = { 0.0, 0.0, 0.0 };
   const size_t found = s.Positions.size();
   if (this->Transforms.empty())
@@ -213,7 +215,7 @@ bool FluidSurface::Evaluate(const double x[3], double& value, double gradient[3]
       {
         continue;
       }
-      const double v = this->Volumes[p] * invH3;
+      const double v = this->Volumes[p]; // V_j / H^3
       c += v * this->Unit.Value(q);
       if (gradient && q > 0.0)
       {
@@ -239,7 +241,7 @@ bool FluidSurface::Evaluate(const double x[3], double& value, double gradient[3]
       {
         continue;
       }
-      const double v = this->Volumes[p] * invH3;
+      const double v = this->Volumes[p]; // V_j / H^3
       c += v * this->Unit.Value(q);
       if (gradient && q > 0.0)
       {

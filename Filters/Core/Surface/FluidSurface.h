@@ -71,7 +71,7 @@ private:
   double ParticleSpacing = 0.0;
   double Volume = 0.0;
   double QueryRadius = 0.0;
-  std::vector<double> Volumes;    // sorted order
+  std::vector<double> Volumes;    // sorted order, V_j / H^3
   std::vector<double> Centres;    // sorted order, 3 per particle (smoothed when anisotropic)
   std::vector<double> Transforms; // sorted order, 9 per particle: G_j * H (anisotropic only)
   std::vector<double> Determinants; // det(G_j H) (anisotropic only)
