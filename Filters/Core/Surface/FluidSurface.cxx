@@ -32,9 +32,7 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
   this->Grid = &grid;
   this->Options = options;
   this->Unit = Kernel(KernelType::Wendland, 3, 1.0);
-  const Index n = grid.NumberOfPoints();
   const Index nv = grid.NumberOfValidPoints();
-  this->Boundary.assign(static_cast<size_t>(n), 0);
   this->Volumes.clear();
   this->Centres.clear();
   this->Transforms.clear();
@@ -75,25 +73,25 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
     this->H = extent > 0.0 ? extent : 1.0;
   }
 
-  // Number densities sum_k W(|x_j - x_k|, H) (the particle itself included), and every volume, in units of
-  // H^3: with a kernel radius of 1e300 (or particles at 1e-300) H^3 and 1/H^3 leave double's range, the
-  // ratios do not.
-  std::vector<double> density(static_cast<size_t>(nv), 0.0);
+  // The bulk's number density sum_k W(|x_j - x_k|, H) (the particle itself included), as the median over the
+  // sample, and every volume, in units of H^3: with a kernel radius of 1e300 (or particles at 1e-300) H^3 and
+  // 1/H^3 leave double's range, the ratios do not.
+  std::vector<double> density(static_cast<size_t>(samples), 0.0);
   const double invH = 1.0 / this->H;
 #pragma omp parallel
   {
     std::vector<Index> pos;
     std::vector<double> d2;
-#pragma omp for schedule(dynamic, 256)
-    for (Index s = 0; s < nv; ++s)
+#pragma omp for schedule(dynamic, 16)
+    for (Index j = 0; j < samples; ++j)
     {
-      grid.FindWithinRadiusPositions(sorted + 3 * s, this->H, pos, d2);
+      grid.FindWithinRadiusPositions(sorted + 3 * (j * nv / samples), this->H, pos, d2);
       double sum = 0.0;
       for (double r2 : d2)
       {
         sum += this->Unit.ValueSquared(r2 * invH * invH);
       }
-      density[s] = sum;
+      density[j] = sum;
     }
   }
   const double bulk = Median(density);
@@ -109,8 +107,6 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
       this->Volumes[s] = volumes[id] * invH * invH * invH;
     }
     total += this->Volumes[s];
-    const double colour = density[s] * v0;
-    this->Boundary[id] = colour < 0.9 || colour > 1.1 ? 1 : 0;
   }
   this->Volume = total * this->H * this->H * this->H;
   this->QueryRadius = this->H;

@@ -9,7 +9,8 @@
  * contouring is f = Level - c (negative inside), grad f = -grad c. W is the Wendland C2 kernel normalised in
  * 3D with support H. Volumes: V_j = m_j / rho_j when the caller gives them; otherwise one volume for every
  * particle, V0 = the median over particles of 1 / sum_k W(|x_j - x_k|, H) (the inverse number density of the
- * bulk; per-particle inverse densities would inflate the sparse outer layer and push the surface outwards).
+ * bulk, taken on a sample of particles; per-particle inverse densities would inflate the sparse outer layer and
+ * push the surface outwards).
  * With V0 the particles' volume is N V0, and c = 0.5 sits, for a flat free surface, where the continuous
  * fluid of that volume ends (the midpoint rule of the layers' sum), so Level 0.5 encloses the particles'
  * volume up to O(H^2 curvature).
@@ -59,9 +60,6 @@ public:
   double Spacing() const { return this->ParticleSpacing; }
   /// Sum of the particles' volumes.
   double TotalVolume() const { return this->Volume; }
-  /// Whether particle j (caller's order) is near the free surface: its colour is below 0.9 (or above
-  /// 1.1, for a cavity's rim). Valid after SetParticles().
-  bool NearSurface(Index j) const { return this->Boundary[j] != 0; }
 
 private:
   const NeighborGrid* Grid = nullptr;
@@ -75,7 +73,6 @@ private:
   std::vector<double> Centres;    // sorted order, 3 per particle (smoothed when anisotropic)
   std::vector<double> Transforms; // sorted order, 9 per particle: G_j * H (anisotropic only)
   std::vector<double> Determinants; // det(G_j H) (anisotropic only)
-  std::vector<unsigned char> Boundary; // caller's order
 };
 
 } // namespace meshfree

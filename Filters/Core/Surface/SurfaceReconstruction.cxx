@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 namespace meshfree
@@ -106,11 +107,11 @@ void ChooseLattice(const NeighborGrid& grid, double cell, double margin, Contour
 
 /// Seed cells of the continuation: per occupied block of 4^3 lattice cells, its first chosen point is moved
 /// onto the surface (a few projection steps, at most `reach` away) and the cell it lands in is a seed; a point
-/// that cannot be projected seeds nothing. Every piece of surface near the data gets many seeds, yet
+/// that cannot be projected, or where |f| >= `farther`, seeds nothing. Every piece of surface near the data gets many seeds, yet
 /// only the cells the surface crosses are evaluated (seeding every occupied cell would evaluate the whole
 /// noisy shell of points, several cells thick).
 std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitField& field, const ContourOptions& lattice,
-  double reach, const std::vector<unsigned char>& chosen)
+  double reach, const std::vector<unsigned char>& chosen, double farther = std::numeric_limits<double>::infinity())
 {
   const std::vector<Index>& order = grid.SortedOrder();
   const double* sorted = grid.SortedPoints();
@@ -144,6 +145,11 @@ std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitFie
       double x[3], n[3];
       const double* p = sorted + 3 * blocks[b].second;
       std::copy(p, p + 3, x);
+      double f = 0.0;
+      if (!(farther == std::numeric_limits<double>::infinity()) && (!field.Evaluate(x, f, nullptr, scratch) || !(std::fabs(f) < farther)))
+      {
+        continue; // far from the surface by the field's own measure (a particle deep in the fluid)
+      }
       bool projected = field.Project(x, n, reach, 3, scratch);
       if (!projected)
       {
@@ -333,19 +339,14 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     }
     margin = 2.0 * fluid->SupportRadius();
     ChooseLattice(grid, cell, margin, lattice, report.CellSizeEnlarged);
-    // Seeds from the particles near the free surface (all of them when none is, e.g. a single particle).
-    std::vector<unsigned char> near(static_cast<size_t>(input.Count), 0);
-    bool any = false;
-    for (Index i = 0; i < input.Count; ++i)
+    // Every particle may seed, but one deep in the fluid (colour above 0.9 or below 0.1: |level - c| >= 0.4,
+    // a flat field where projection has no direction) is passed over.
+    const std::vector<unsigned char> near(static_cast<size_t>(input.Count), 1);
+    seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near, 0.4);
+    if (seeds.empty())
     {
-      near[i] = fluid->NearSurface(i) ? 1 : 0;
-      any = any || near[i];
+      seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near); // a lone droplet: no bulk
     }
-    if (!any)
-    {
-      std::fill(near.begin(), near.end(), 1);
-    }
-    seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near);
     field = std::move(fluid);
     if (progress && !progress(0.2))
     {
