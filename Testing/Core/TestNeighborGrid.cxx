@@ -658,7 +658,7 @@ TEST(NeighborGrid, LargeK)
 
 TEST(NeighborGrid, PortableKernelGivesTheSameResults)
 {
-  // The distance filter has an AVX-512 variant; the portable one must give bit-identical results.
+  // The distance filter has vector variants (AVX-512, AVX2); the portable one must give bit-identical results.
   struct Restore
   {
     ~Restore() { NeighborGrid::SetVectorized(true); }

@@ -16,7 +16,7 @@
 #endif
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
-#define MESHFREE_GRID_AVX512 1 // a filter kernel for CPUs with AVX-512, chosen at run time
+#define MESHFREE_GRID_AVX512 1 // filter kernels for CPUs with AVX-512 or AVX2, chosen at run time
 #endif
 
 namespace meshfree
@@ -264,6 +264,66 @@ __attribute__((target("avx512f"))) int FilterAvx512(const double* xyz, const Cel
 }
 #endif
 
+#ifdef MESHFREE_GRID_AVX512
+// AVX2 (no FMA in the target, so multiplies and adds stay separate): four interleaved points (12 doubles in
+// three registers) are split into x, y and z registers by two blends and a lane permutation each; the kept
+// lanes are written in order as in the scalar kernel (the outputs have room for 8 entries more).
+__attribute__((target("avx2"))) int FilterAvx2(const double* xyz, const CellRange* ranges, int rangeCount,
+  const double x[3], double cut, double* dist2, Index* pos)
+{
+  const __m256d qx = _mm256_set1_pd(x[0]), qy = _mm256_set1_pd(x[1]), qz = _mm256_set1_pd(x[2]);
+  const __m256d limit = _mm256_set1_pd(cut);
+  int count = 0;
+  alignas(32) double d2s[4];
+  for (int r = 0; r < rangeCount; ++r)
+  {
+    const Index end = ranges[r].End;
+    Index s = ranges[r].Begin;
+    for (; s + 4 <= end; s += 4)
+    {
+      const double* p = xyz + 3 * s;
+      const __m256d v0 = _mm256_loadu_pd(p);     // x0 y0 z0 x1
+      const __m256d v1 = _mm256_loadu_pd(p + 4); // y1 z1 x2 y2
+      const __m256d v2 = _mm256_loadu_pd(p + 8); // z2 x3 y3 z3
+      const __m256d px = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(v0, v1, 0x4), v2, 0x2), 0x6C);
+      const __m256d py = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(v0, v1, 0x9), v2, 0x4), 0xB1);
+      const __m256d pz = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(v0, v1, 0x2), v2, 0x9), 0xC6);
+      const __m256d dx = _mm256_sub_pd(px, qx), dy = _mm256_sub_pd(py, qy), dz = _mm256_sub_pd(pz, qz);
+      const __m256d d2 =
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz));
+      const int keep = _mm256_movemask_pd(_mm256_cmp_pd(d2, limit, _CMP_LE_OQ));
+      if (keep == 0)
+      {
+        continue;
+      }
+      _mm256_store_pd(d2s, d2);
+      for (int lane = 0; lane < 4; ++lane) // branch-free: the mask decides
+      {
+        if (dist2 != nullptr)
+        {
+          dist2[count] = d2s[lane];
+        }
+        pos[count] = s + lane;
+        count += (keep >> lane) & 1;
+      }
+    }
+    for (; s < end; ++s)
+    {
+      const double* p = xyz + 3 * s;
+      const double dx = p[0] - x[0], dy = p[1] - x[1], dz = p[2] - x[2];
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      if (dist2 != nullptr)
+      {
+        dist2[count] = d2;
+      }
+      pos[count] = s;
+      count += d2 <= cut ? 1 : 0;
+    }
+  }
+  return count;
+}
+#endif
+
 using FilterFunction = int (*)(const double*, const CellRange*, int, const double*, double, double*, Index*);
 
 FilterFunction VectorFilter()
@@ -273,6 +333,10 @@ FilterFunction VectorFilter()
   if (__builtin_cpu_supports("avx512f"))
   {
     return FilterAvx512;
+  }
+  if (__builtin_cpu_supports("avx2"))
+  {
+    return FilterAvx2;
   }
 #endif
   return nullptr;

@@ -107,8 +107,8 @@ public:
   double GetPointsPerCell() const { return this->PointsPerCell; }
   ///@}
 
-  /// Distances are filtered with an AVX-512 kernel when the CPU has it (chosen at run time; results are
-  /// bit-identical to the portable code). SetVectorized(false) forces the portable code for every grid,
+  /// Distances are filtered with an AVX-512 or AVX2 kernel when the CPU has one (chosen at run time; results
+  /// are bit-identical to the portable code). SetVectorized(false) forces the portable code for every grid,
   /// e.g. to compare the two; call it while no query runs. Returns whether the vector kernel is in use.
   static bool SetVectorized(bool enable);
 

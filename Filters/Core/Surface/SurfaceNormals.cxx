@@ -51,7 +51,8 @@ int NearestDistinct(const NeighborGrid& grid, const double x[3], int k, std::vec
 
 /// PCA of the points at sorted positions pos[0..count) of `sorted`, about their centroid, in coordinates
 /// shifted to x and scaled by 1/scale.
-LocalPCA PrincipalAxes(const double* sorted, const Index* pos, size_t count, const double x[3], double scale)
+LocalPCA PrincipalAxes(
+  const double* sorted, const Index* pos, size_t count, const double x[3], double scale, bool jet)
 {
   LocalPCA out;
   if (count < 3 || !(scale > 0.0))
@@ -104,7 +105,7 @@ LocalPCA PrincipalAxes(const double* sorted, const Index* pos, size_t count, con
   // n - a1 t1 - a2 t2. Exact on quadrics, where PCA is biased by O(kappa R) (0.16-0.45 degrees at k = 20).
   // For a symmetric support the slopes are orthogonal to the quadratic terms, so noise tilts them no
   // more than PCA's plane. Fewer than 2 neighbours per term, or a degenerate fit, keep the PCA normal.
-  if (count >= 12)
+  if (jet && count >= 12)
   {
     const Eigen::Vector3d t1 = eig.eigenvectors().col(2).normalized();
     const Eigen::Vector3d t2 = n.cross(t1);
@@ -161,31 +162,55 @@ double Median(std::vector<double> v)
 /// From a radius query's result (sorted positions `pos`, squared distances `r2`) around a point: the distance
 /// to its k-th nearest other point and its `degree` nearest others (original indices, ordered by (distance,
 /// index) like NeighborGrid::FindKNearest), exact duplicates of the point left out. False (nothing written)
-/// when the list holds fewer than k such points. `pairs` is scratch.
+/// when the list holds fewer than k such points. `keys` is scratch.
 bool NearestOfList(const std::vector<Index>& pos, const std::vector<double>& r2, int k,
-  const std::vector<Index>& order, std::int32_t* row, int degree, double& kth,
-  std::vector<std::pair<double, Index>>& pairs)
+  const std::vector<Index>& order, std::int32_t* row, int degree, double& kth, std::vector<double>& keys)
 {
-  pairs.clear();
-  for (size_t j = 0; j < pos.size(); ++j)
+  keys.clear();
+  for (double d2 : r2)
   {
-    if (r2[j] > 0.0) // the point itself and its exact duplicates are not neighbours
+    if (d2 > 0.0) // the point itself and its exact duplicates are not neighbours
     {
-      pairs.emplace_back(r2[j], order[pos[j]]);
+      keys.push_back(d2);
     }
   }
-  const size_t want = static_cast<size_t>(k);
-  if (pairs.size() < want || want == 0)
+  if (keys.size() < static_cast<size_t>(k) || k <= 0)
   {
     return false;
   }
-  std::nth_element(pairs.begin(), pairs.begin() + (want - 1), pairs.end());
-  kth = std::sqrt(pairs[want - 1].first);
-  const size_t kept = std::min(static_cast<size_t>(degree), want);
-  std::partial_sort(pairs.begin(), pairs.begin() + kept, pairs.begin() + want);
-  for (size_t j = 0; j < kept; ++j)
+  std::nth_element(keys.begin(), keys.begin() + (k - 1), keys.end());
+  kth = std::sqrt(keys[k - 1]);
+  // The `degree` nearest by (distance, index), kept sorted by insertion (degree is small).
+  constexpr int MaxDegree = 64;
+  const int want = std::min(std::min(degree, k), MaxDegree);
+  double bestD2[MaxDegree];
+  Index bestId[MaxDegree];
+  int kept = 0;
+  for (size_t j = 0; j < pos.size(); ++j)
   {
-    row[j] = static_cast<std::int32_t>(pairs[j].second);
+    const double d2 = r2[j];
+    if (!(d2 > 0.0) || (kept == want && d2 > bestD2[want - 1]))
+    {
+      continue;
+    }
+    const Index id = order[pos[j]];
+    if (kept == want && d2 == bestD2[want - 1] && id > bestId[want - 1])
+    {
+      continue;
+    }
+    int at = kept < want ? kept++ : want - 1;
+    while (at > 0 && (bestD2[at - 1] > d2 || (bestD2[at - 1] == d2 && bestId[at - 1] > id)))
+    {
+      bestD2[at] = bestD2[at - 1];
+      bestId[at] = bestId[at - 1];
+      --at;
+    }
+    bestD2[at] = d2;
+    bestId[at] = id;
+  }
+  for (int j = 0; j < kept; ++j)
+  {
+    row[j] = static_cast<std::int32_t>(bestId[j]);
   }
   return true;
 }
@@ -273,7 +298,7 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
         continue;
       }
       grid.FindWithinRadiusPositions(x, kth[j], pos, d2);
-      const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, kth[j]);
+      const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, kth[j], false);
       spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
     }
   }
@@ -297,7 +322,7 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
       {
         const double* x = sorted + 3 * (j * nv / samples);
         grid.FindWithinRadiusPositions(x, radius, pos, d2);
-        const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius);
+        const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius, false);
         spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
       }
     }
@@ -356,7 +381,7 @@ bool EstimateNormals(
     {
       std::vector<Index> ids, pos;
       std::vector<double> d2, r2;
-      std::vector<std::pair<double, Index>> pairs;
+      std::vector<double> keys;
 #pragma omp for schedule(dynamic, 256)
       for (Index s = begin; s < end; ++s)
       {
@@ -371,7 +396,7 @@ bool EstimateNormals(
           grid.FindWithinRadiusPositions(x, first, pos, r2);
         }
         double radius = first;
-        if (!(first > 0.0 && NearestOfList(pos, r2, k, order, row, degree, field.NeighborDistance[id], pairs)))
+        if (!(first > 0.0 && NearestOfList(pos, r2, k, order, row, degree, field.NeighborDistance[id], keys)))
         {
           const int found = NearestDistinct(grid, x, k, ids, d2, field.NeighborDistance[id]);
           int kept = 0;
@@ -388,7 +413,9 @@ bool EstimateNormals(
             grid.FindWithinRadiusPositions(x, radius, pos, r2);
           }
         }
-        const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius);
+        // Where the noise sets the radius, the quadric's exactness is below the noise's tilt: PCA suffices.
+        const bool jet = fixed || !(noiseRadius > field.NeighborDistance[id]);
+        const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius, jet);
         if (!pca.Valid)
         {
           ++bad;
