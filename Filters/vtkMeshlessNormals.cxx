@@ -32,21 +32,7 @@ const char* OrientationName(int orientation)
   return orientation >= 0 && orientation < 4 ? names[orientation] : "?";
 }
 
-/// The result for a cloud without a single finite point: every point invalid, every array 0.
-void NoResult(const std::vector<double>& xyz, vtkIdType n, meshfree::CloudNormalsResult& result)
-{
-  result = meshfree::CloudNormalsResult();
-  const size_t count = static_cast<size_t>(n);
-  result.Normals.assign(3 * count, 0.0);
-  result.Curvature.assign(count, 0.0);
-  result.SurfaceVariation.assign(count, 0.0);
-  result.Confidence.assign(count, 0.0);
-  result.Radius.assign(count, 0.0);
-  result.Valid.assign(count, 0);
-  result.Points = xyz;
-  result.Invalid = n;
-}
-
+/// A named double array of n tuples copied from values.
 vtkSmartPointer<vtkDoubleArray> NewArray(const char* name, int components, const double* values, vtkIdType n)
 {
   auto array = vtkSmartPointer<vtkDoubleArray>::New();
@@ -106,12 +92,9 @@ int vtkMeshlessNormals::RequestData(
   // Validate and gather: coordinates as doubles, the input's Normals as orientation reference.
   const vtkIdType n = input->GetNumberOfPoints();
   std::vector<double> xyz(3 * static_cast<size_t>(n));
-  vtkIdType finite = 0;
   for (vtkIdType i = 0; i < n; ++i)
   {
-    double* x = &xyz[3 * i];
-    input->GetPoint(i, x);
-    finite += std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]) ? 1 : 0;
+    input->GetPoint(i, &xyz[3 * i]);
   }
   std::vector<double> reference;
   vtkDataArray* inputNormals = input->GetPointData()->GetArray(kNormals);
@@ -154,20 +137,11 @@ int vtkMeshlessNormals::RequestData(
   options.ProjectPoints = this->ProjectPoints;
   options.ProjectionIterations = this->ProjectionIterations;
   meshfree::CloudNormalsResult result;
-  bool done = true;
-  if (finite > 0)
-  {
-    done = meshfree::ComputeCloudNormals(xyz.data(), n, useReference ? reference.data() : nullptr, options, result,
-      [this](double fraction) {
-        this->UpdateProgress(fraction);
-        return !this->GetAbortExecute();
-      });
-  }
-  else
-  {
-    // No point to compute anything for (the core is not called: it needs at least one finite point).
-    NoResult(xyz, n, result);
-  }
+  const bool done = meshfree::ComputeCloudNormals(xyz.data(), n, useReference ? reference.data() : nullptr,
+    options, result, [this](double fraction) {
+      this->UpdateProgress(fraction);
+      return !this->GetAbortExecute();
+    });
   if (!done || result.Aborted)
   {
     output->Initialize();

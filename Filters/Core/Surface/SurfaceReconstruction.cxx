@@ -382,9 +382,9 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       normals, options.SupportScale, options.NoiseScale, options.SupportRadius > 0.0, report.SupportRadius);
     if (!(cell > 0.0))
     {
-      // 1.5 sample spacings (about 0.7 vertices per sample), or half the radius the noise asks for (finer detail
-      // than the noise leaves the fits cannot represent); the projection makes accuracy independent of it.
-      cell = std::max(1.5 * normals.Scale.Spacing, 0.5 * normals.Scale.Radius);
+      // 1.5 sample spacings (about 0.7 vertices per sample), or a quarter of the fits' support (finer detail
+      // than that the fits cannot represent); the projection makes accuracy independent of it.
+      cell = std::max(1.5 * normals.Scale.Spacing, 0.25 * report.SupportRadius);
     }
     if (!(cell > 0.0))
     {
