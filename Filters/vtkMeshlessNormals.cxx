@@ -134,6 +134,7 @@ int vtkMeshlessNormals::RequestData(
     : this->Orientation == VIEWPOINT ? meshfree::OrientationMode::Viewpoint
                                      : meshfree::OrientationMode::Propagation;
   std::copy(this->Viewpoint, this->Viewpoint + 3, options.Viewpoint);
+  options.ComputeCurvature = this->ComputeCurvature;
   options.ProjectPoints = this->ProjectPoints;
   options.ProjectionIterations = this->ProjectionIterations;
   meshfree::CloudNormalsResult result;
@@ -174,7 +175,10 @@ int vtkMeshlessNormals::RequestData(
   }
   vtkPointData* pd = output->GetPointData();
   pd->SetNormals(NewArray(kNormals, 3, result.Normals.data(), n));
-  pd->AddArray(NewArray("Curvature", 1, result.Curvature.data(), n));
+  if (this->ComputeCurvature)
+  {
+    pd->AddArray(NewArray("Curvature", 1, result.Curvature.data(), n));
+  }
   pd->AddArray(NewArray("SurfaceVariation", 1, result.SurfaceVariation.data(), n));
   pd->AddArray(NewArray("OrientationConfidence", 1, result.Confidence.data(), n));
   vtkNew<vtkCharArray> mask;
@@ -185,7 +189,7 @@ int vtkMeshlessNormals::RequestData(
     mask->SetValue(i, static_cast<char>(result.Valid[i] ? 1 : 0));
   }
   pd->AddArray(mask);
-  pd->SetActiveScalars("Curvature");
+  pd->SetActiveScalars(this->ComputeCurvature ? "Curvature" : "OrientationConfidence");
 
   vtkFieldData* fd = output->GetFieldData();
   AddFieldValue(fd, "NoiseEstimate", result.Scale.Noise);
@@ -205,6 +209,7 @@ void vtkMeshlessNormals::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Orientation: " << OrientationName(this->Orientation) << "\n";
   os << indent << "Viewpoint: " << this->Viewpoint[0] << ", " << this->Viewpoint[1] << ", " << this->Viewpoint[2]
      << "\n";
+  os << indent << "ComputeCurvature: " << this->ComputeCurvature << "\n";
   os << indent << "ProjectPoints: " << this->ProjectPoints << "\n";
   os << indent << "ProjectionIterations: " << this->ProjectionIterations << "\n";
 }

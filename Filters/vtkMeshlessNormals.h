@@ -5,8 +5,8 @@
  *
  * Input port 0 is a point cloud (vtkPointSet). The output is the input (shallow copy) with the point arrays
  * - `Normals`: unit, consistently oriented (outward on a closed object); also the active normals;
- * - `Curvature`: mean curvature of the algebraic sphere fitted at the point, 1 / length, positive where the
- *   surface is convex with respect to the normals;
+ * - `Curvature` (unless ComputeCurvature is off): mean curvature of the algebraic sphere fitted at the point,
+ *   1 / length, positive where the surface is convex with respect to the normals;
  * - `SurfaceVariation`: l0 / (l0 + l1 + l2) of the neighbourhood's PCA (0 on a plane, 1/3 for isotropic scatter);
  * - `OrientationConfidence`: how unambiguous the orientation was (below 0.5: ambiguous);
  * - `vtkValidPointMask`: 0 where no normal could be computed (NaN/Inf coordinates, degenerate
@@ -80,6 +80,14 @@ public:
   ///@}
 
   ///@{
+  /// Compute the Curvature array (default on). Its sphere fits cost about as much as the normals and their
+  /// orientation together; off, the output has no Curvature (unless ProjectPoints, which fits anyway).
+  vtkSetMacro(ComputeCurvature, bool);
+  vtkGetMacro(ComputeCurvature, bool);
+  vtkBooleanMacro(ComputeCurvature, bool);
+  ///@}
+
+  ///@{
   /// Move the points onto their MLS surface (default off).
   vtkSetMacro(ProjectPoints, bool);
   vtkGetMacro(ProjectPoints, bool);
@@ -102,6 +110,7 @@ protected:
   double SupportRadius = 0.0;
   int Orientation = AUTO;
   double Viewpoint[3] = { 0.0, 0.0, 0.0 };
+  bool ComputeCurvature = true;
   bool ProjectPoints = false;
   int ProjectionIterations = 2;
 

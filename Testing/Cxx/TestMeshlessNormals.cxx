@@ -185,6 +185,20 @@ void TestNoisyTorus()
   std::cout << "Noisy torus: mean angle error " << s.MeanAngle << " degrees, " << 100.0 * s.Outward
             << " % outward, noise estimate " << (noise ? noise->GetTuple1(0) : -1.0) << "\n";
 
+  // ComputeCurvature off: the same normals, no Curvature array.
+  vtkNew<vtkDoubleArray> kept;
+  kept->DeepCopy(out->GetPointData()->GetNormals());
+  normals->ComputeCurvatureOff();
+  normals->Update();
+  Check(out->GetPointData()->GetArray("Curvature") == nullptr, "ComputeCurvature off: a Curvature array");
+  double largest = 0.0;
+  for (vtkIdType i = 0; i < out->GetNumberOfPoints(); ++i)
+    for (int a = 0; a < 3; ++a)
+      largest = std::max(largest,
+        std::fabs(out->GetPointData()->GetNormals()->GetComponent(i, a) - kept->GetComponent(i, a)));
+  Check(largest == 0.0, "ComputeCurvature off changed the normals by " + std::to_string(largest));
+  normals->ComputeCurvatureOn();
+
   double before[3];
   cloud->GetPoint(0, before);
   normals->ProjectPointsOn();

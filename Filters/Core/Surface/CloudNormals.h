@@ -8,6 +8,8 @@
  * 1 / radius, positive where the surface is convex (outward normals), in 1 / length; exact on spheres.
  * Projection moves each point onto the sphere fitted at it and refits there (ProjectionIterations times,
  * at most one fit support away); the normal and curvature are then those at the projected point.
+ * The curvature's fits cost about as much as the normals and their orientation together (their support
+ * is twice the normals' where noise sets it): ComputeCurvature off skips them.
  * Orientation: reference normals when given (the input's own `Normals`), else propagation or a viewpoint.
  */
 #ifndef meshfree_CloudNormals_h
@@ -27,6 +29,7 @@ struct CloudNormalsOptions
   NormalOptions Neighborhood;
   OrientationMode Orientation = OrientationMode::Propagation; // Reference needs ReferenceNormals
   double Viewpoint[3] = { 0.0, 0.0, 0.0 };
+  bool ComputeCurvature = true; // off: no sphere fits (unless ProjectPoints), Curvature stays 0
   bool ProjectPoints = false;
   int ProjectionIterations = 2;
   double SupportScale = 2.0; // fits for curvature and projection: as SurfaceOptions
