@@ -56,6 +56,8 @@ surface.csv columns:
                   filter's Update(); VTK: its algorithms' Update(); Open3D: the calls; PCL: the times the tools
                   print (lines other than loading and saving)
   peak_mb         median peak resident memory of the process (MiB)
+  algo_mb         median memory the algorithm took on top of its input (MiB): peak resident memory at its end
+                  less resident memory at its start (surface_memory.py); not PCL (its tools read and write)
   cpu_pct         median CPU use of the process (100 = one core busy the whole time)
   load1           median 1-minute load average before the runs (the machine is shared: read times with it)
   rms, max, p99, bias     distances of the mesh vertices (mesh groups) or points (smooth) to the true surface;
@@ -96,8 +98,8 @@ TOOLS = ("meshfree", "vtk", "open3d", "pcl")
 PCL_TOOLS = ("pcl_normal_estimation", "pcl_mls_smoothing", "pcl_poisson_reconstruction")
 
 COLUMNS = ["case", "key", "group", "peer", "tool", "settings", "cloud", "shape", "n", "sigma", "status", "reps",
-           "wall_s", "algo_s", "peak_mb", "cpu_pct", "load1", "rms", "max", "p99", "bias", "cov_mean", "cov_max",
-           "triangles", "vertices", "boundary_edges", "nonmanifold_edges", "euler", "components", "watertight",
+           "wall_s", "algo_s", "peak_mb", "algo_mb", "cpu_pct", "load1", "rms", "max", "p99", "bias", "cov_mean",
+           "cov_max", "triangles", "vertices", "boundary_edges", "nonmanifold_edges", "euler", "components", "watertight",
            "nan_vertices", "volume", "volume_ref", "volume_err", "ref_radius", "mesh_normal_angle",
            "mesh_normal_outward", "ang_mean", "ang_p95", "consistent", "outward", "command", "note", "run"]
 GROUPS = [("mesh+N", "Meshes from points with exact normals"), ("mesh", "Meshes from positions only"),
@@ -357,10 +359,12 @@ def run_case(case, cfg):
             r["algo_s"] = _pcl_seconds(r["stdout"] + "\n" + r["stderr"])
         elif case["tool"] == "meshfree":
             r["algo_s"] = info.get("update_s")
+            r["algo_mb"] = info.get("algo_mb")
             if "error" in info:
                 r["rc"], r["stderr"] = r["rc"] or 2, info["error"]
         else:
             r["algo_s"] = info.get("algo_s")
+            r["algo_mb"] = info.get("algo_mb")
         runs.append(r)
         if r["rc"] != 0 or r["wall_s"] > cfg.max_rep_s:
             break
@@ -387,7 +391,7 @@ def run_meshfree_batch(cases, cfg):
     for i, case in enumerate(cases):
         info = results.get(i, {"error": "no result (runner exit %s)" % r["rc"]})
         one = dict(rc=2 if "error" in info else 0, load1=load, peak_mb=r["peak_mb"], cpu_pct=r["cpu_pct"],
-                   algo_s=info.get("update_s"), stdout="", stderr=info.get("error", ""),
+                   algo_s=info.get("update_s"), algo_mb=info.get("algo_mb"), stdout="", stderr=info.get("error", ""),
                    wall_s=sum(info.get(k, 0.0) for k in ("read_s", "update_s", "write_s")))
         out.append([one])
     log("  MeshFree batch: %d cases in one process, %.1f s, peak %.0f MB" % (len(cases), r["wall_s"],
@@ -437,7 +441,7 @@ def make_row(case, runs, status, note=""):
     ok = [r for r in runs if r["rc"] == 0]
     if ok:
         row["reps"] = len(ok)
-        for key in ("wall_s", "algo_s", "peak_mb", "cpu_pct", "load1"):
+        for key in ("wall_s", "algo_s", "peak_mb", "algo_mb", "cpu_pct", "load1"):
             values = [r[key] for r in ok if r.get(key) is not None]
             row[key] = statistics.median(values) if values else None
     return row
@@ -577,10 +581,10 @@ def write_markdown(path, rows, header_lines):
                 continue
             lines += ["#### %s — %s" % (group, cl), ""]
             if mesh:
-                head = ["peer", "wall s (runs)", "algo s", "peak MB", "load", "rms", "max", "bias", "cov mean",
+                head = ["peer", "wall s (runs)", "algo s", "peak MB", "algo MB", "load", "rms", "max", "bias", "cov mean",
                         "cov max", "triangles", "watertight", "χ", "pieces", "volume err"]
             else:
-                head = ["peer", "wall s (runs)", "algo s", "peak MB", "load"] + (
+                head = ["peer", "wall s (runs)", "algo s", "peak MB", "algo MB", "load"] + (
                     ["rms", "max", "p99", "bias"] if group == "smooth" else []) + [
                     "mean angle °", "p95 °", "consistent", "outward"]
             lines += ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
@@ -590,7 +594,7 @@ def write_markdown(path, rows, header_lines):
                                  + " |" * (len(head) - 2))
                     continue
                 cells = [r["peer"], _wall(r), _num(r["algo_s"], "%.2f"), _num(r["peak_mb"], "%.0f"),
-                         _num(r["load1"], "%.1f")]
+                         _num(r.get("algo_mb"), "%.0f"), _num(r["load1"], "%.1f")]
                 if mesh:
                     cells += [_num(r["rms"]), _num(r["max"]), _num(r["bias"]), _num(r["cov_mean"]),
                               _num(r["cov_max"]), _num(r["triangles"], "%d"), _watertight(r), _num(r["euler"], "%d"),
@@ -627,7 +631,10 @@ def write_report(out, rows, runs):
     header += ["", "Machine: %s. Every case in its own process through `/usr/bin/time -v` (wall time, peak "
                "memory), with no OMP_* variable set (each tool's default threads); medians of the runs. "
                "'wall s' is the whole process (start-up and file input/output included), 'algo s' the tool's own "
-               "computation (MeshFree: the filter's Update()); 'load' the 1-minute load average." % (
+               "computation (MeshFree: the filter's Update()); 'peak MB' the whole process's peak memory (pvpython "
+               "with ParaView's libraries and the plugin starts at 320 MB, python3 with VTK at 95 MB, with Open3D at 80 MB), "
+               "'algo MB' what the computation took on top of its input (peak at its end less resident memory "
+               "at its start, surface_memory.py); 'load' the 1-minute load average." % (
                    runs[-1]["machine"]),
                "",
                "Scores (surface_score.py; every column is described in bench_surface.py): distances of the mesh "

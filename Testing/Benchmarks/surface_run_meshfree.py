@@ -20,6 +20,8 @@ import os
 import sys
 import time
 
+from surface_memory import AlgorithmMemory
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(os.path.dirname(HERE))
 PLUGIN_REL = os.path.join("lib", "paraview-5.11", "plugins", "MeshFree", "MeshFree.so")
@@ -70,9 +72,12 @@ def run_job(simple, job):
         setattr(filt, name, value)
     filt.UpdateVTKObjects()
     algorithm = filt.GetClientSideObject()
+    memory = AlgorithmMemory()
+    memory.start()
     t0 = time.perf_counter()
     algorithm.Update()
     update_s = time.perf_counter() - t0
+    algo_mb = memory.stop()
     out = algorithm.GetOutputDataObject(0)
     if out is None or out.GetNumberOfPoints() == 0:
         return {"error": "%s produced no points" % proxy_name, "update_s": update_s}
@@ -91,7 +96,7 @@ def run_job(simple, job):
     ok = w.Write()
     write_s = time.perf_counter() - t0
     arrays = out.GetPointData()
-    result = dict(update_s=update_s, read_s=read_s, write_s=write_s, points_out=out.GetNumberOfPoints(),
+    result = dict(update_s=update_s, algo_mb=algo_mb, read_s=read_s, write_s=write_s, points_out=out.GetNumberOfPoints(),
                   polys_out=out.GetNumberOfPolys(),
                   arrays_out=[arrays.GetArrayName(i) for i in range(arrays.GetNumberOfArrays())])
     if not ok:

@@ -12,7 +12,8 @@
         what a ParaView user does today
 
 Runs under Debian's python3 (python3-paraview) or pvpython. Prints one JSON line: the seconds of each stage
-without file input/output (algo_s = their sum) and the grid used.
+without file input/output (algo_s = their sum), the memory they took (algo_mb, surface_memory.py) and the
+grid used.
 """
 import argparse
 import json
@@ -23,6 +24,7 @@ import time
 
 os.environ.setdefault("VTK_SMP_BACKEND_IN_USE", "STDThread")
 
+from surface_memory import AlgorithmMemory  # noqa: E402
 from vtkmodules.util.numpy_support import numpy_to_vtk  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData, vtkStaticPointLocator  # noqa: E402
 from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D  # noqa: E402
@@ -71,6 +73,8 @@ def main():
     a = ap.parse_args()
     pd = read_points(a.inp)
     times, info = {}, {}
+    memory = AlgorithmMemory()
+    memory.start()
     if a.mode == "normals":
         f = vtkPCANormalEstimation()
         f.SetInputData(pd)
@@ -124,8 +128,10 @@ def main():
         c.SetValue(0, a.level)
         out = update(c, times, "contour_s")
         info["grid"] = dims
+    algo_mb = memory.stop()
     write(out, a.out)
     times["algo_s"] = sum(times.values())
+    times["algo_mb"] = algo_mb
     times.update(info)
     print(json.dumps(times), flush=True)
 

@@ -178,8 +178,31 @@ void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, con
     for (Index p = 0; p < candidates; ++p)
     {
       const double* c = &centres[3 * p];
-      const double* f = &frames[9 * p];
+      double* f = &frames[9 * p];
       grid.FindWithinRadiusPositions(c, rho, pos, d2);
+      // The frame's normal: the weighted mean of the normals over the whole support, not only the cell's
+      // (a cell may hold a single point deep in the noise whose normal is tilted far off; alone it would set
+      // a patch across the surface and a spurious zero beneath it).
+      double mean[3] = { 0.0, 0.0, 0.0 };
+      for (size_t j = 0; j < pos.size(); ++j)
+      {
+        const Index id = order[pos[j]];
+        const double* nn = normals + 3 * id;
+        const double w = radii[id] > 0.0 ? Wendland(std::sqrt(d2[j]) / rho) : 0.0;
+        for (int a = 0; a < 3; ++a)
+        {
+          mean[a] += w * nn[a];
+        }
+      }
+      const double len = std::sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
+      if (len > 0.0 && std::isfinite(len))
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          f[6 + a] = mean[a] / len;
+        }
+        Tangents(f + 6, f, f + 3);
+      }
       uvh.clear();
       w.clear();
       for (size_t j = 0; j < pos.size(); ++j)

@@ -217,7 +217,6 @@ Index ProjectVertices(const ImplicitField& field, double maxStep, bool project, 
   }
   // Triangle normals (area-weighted) for the rest.
   const Index nt = mesh.NumberOfTriangles();
-  std::vector<double> sum(static_cast<size_t>(3 * nv), 0.0);
   bool any = false;
   for (Index v = 0; v < nv && !any; ++v)
   {
@@ -227,6 +226,7 @@ Index ProjectVertices(const ImplicitField& field, double maxStep, bool project, 
   {
     return projected;
   }
+  std::vector<double> sum(static_cast<size_t>(3 * nv), 0.0);
   for (Index t = 0; t < nt; ++t)
   {
     const Index* id = &mesh.Triangles[3 * t];
