@@ -80,7 +80,6 @@ import datetime
 import json
 import math
 import os
-import platform
 import re
 import shlex
 import shutil
@@ -93,6 +92,8 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
+import bench_machine  # noqa: E402
+
 PLUGIN_REL = os.path.join("lib", "paraview-5.11", "plugins", "MeshFree", "MeshFree.so")
 TOOLS = ("meshfree", "vtk", "open3d", "pcl")
 PCL_TOOLS = ("pcl_normal_estimation", "pcl_mls_smoothing", "pcl_poisson_reconstruction")
@@ -684,25 +685,6 @@ def render_pictures(rows, cfg):
 
 
 # ---------------------------------------------------------------------------------------------- main
-def machine_description():
-    cpu = platform.machine()
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    mem = ""
-    try:
-        with open("/proc/meminfo") as f:
-            mem = ", %.0f GB memory" % (int(f.readline().split()[1]) / 1024.0 ** 2)
-    except (OSError, ValueError, IndexError):
-        pass
-    return "%s, %d cores%s, %s" % (cpu, os.cpu_count(), mem, platform.platform())
-
-
 def default_out():
     plugin = find_plugin()
     d = os.path.dirname(os.path.abspath(plugin))
@@ -891,7 +873,7 @@ def main():
             shlex.quote(os.path.relpath(a, SOURCE) if os.path.isabs(a) and a.startswith(SOURCE + os.sep) else a)
             for a in sys.argv[1:]),
         id=run_id, date=run_id[:16], seconds=round(time.perf_counter() - start),
-        cases=len(runnable), machine=machine_description(),
+        cases=len(runnable), machine=bench_machine.describe(),
         load="%.2f at the start, %.2f at the end, %s before the runs" % (
             load_start[0], load_end[0], "%.2f–%.2f" % (min(loads), max(loads)) if loads else "—"),
         peers="; ".join("%s: %s" % (t, vers.get(t, "found") if t in found and t not in notes else

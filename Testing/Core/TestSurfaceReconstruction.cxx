@@ -256,16 +256,13 @@ double TopFaceSpread(const SurfaceMesh& mesh, double xmin, double xmax, double m
   const double mean = sum / std::max<Index>(count, 1);
   return std::sqrt(std::max(0.0, sum2 / std::max<Index>(count, 1) - mean * mean));
 }
-} // namespace
-
-TEST(SurfaceReconstruction, AnisotropicKernelsKeepAFlatSurfaceFlat)
+/// 40 x 40 x `layers` particles of spacing s from the origin, jittered by 10 % of the spacing.
+std::vector<double> JitteredSlab(int layers, double s, unsigned seed)
 {
-  // A resting block: 40 x 40 x 12 particles, jittered by 10 % of the spacing.
-  const double s = 0.05;
-  std::mt19937_64 rng(5);
+  std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> jitter(-0.1 * s, 0.1 * s);
   std::vector<double> particles;
-  for (int k = 0; k < 12; ++k)
+  for (int k = 0; k < layers; ++k)
   {
     for (int j = 0; j < 40; ++j)
     {
@@ -275,6 +272,15 @@ TEST(SurfaceReconstruction, AnisotropicKernelsKeepAFlatSurfaceFlat)
       }
     }
   }
+  return particles;
+}
+} // namespace
+
+TEST(SurfaceReconstruction, AnisotropicKernelsKeepAFlatSurfaceFlat)
+{
+  // A resting block: 40 x 40 x 12 particles, jittered by 10 % of the spacing.
+  const double s = 0.05;
+  const std::vector<double> particles = JitteredSlab(12, s, 5);
   const Index n = static_cast<Index>(particles.size() / 3);
   const double volume = n * s * s * s;
   double spread[2];
@@ -305,19 +311,7 @@ TEST(SurfaceReconstruction, AnisotropicKernelsKeepAThinSheetThin)
 {
   // A sheet two particles thick (true thickness 2 s, volume N s^3).
   const double s = 0.05;
-  std::mt19937_64 rng(6);
-  std::uniform_real_distribution<double> jitter(-0.1 * s, 0.1 * s);
-  std::vector<double> particles;
-  for (int k = 0; k < 2; ++k)
-  {
-    for (int j = 0; j < 40; ++j)
-    {
-      for (int i = 0; i < 40; ++i)
-      {
-        particles.insert(particles.end(), { (i + 0.5) * s + jitter(rng), (j + 0.5) * s + jitter(rng), (k + 0.5) * s + jitter(rng) });
-      }
-    }
-  }
+  const std::vector<double> particles = JitteredSlab(2, s, 6);
   const Index n = static_cast<Index>(particles.size() / 3);
   double thickness[2], volume[2];
   for (int anisotropic = 0; anisotropic < 2; ++anisotropic)

@@ -192,24 +192,32 @@ void RadixSort(std::uint64_t*& v, std::uint64_t*& scratch, Index m, int lowBit, 
 // whichever one runs.
 using CellRange = NeighborGrid::CellRange;
 
+/// The scalar kernel over sorted positions [begin, end), appending after `count` entries; returns the new count.
+inline int FilterSpan(const double* xyz, Index begin, Index end, const double x[3], double cut, double* dist2,
+  Index* pos, int count)
+{
+  for (Index s = begin; s < end; ++s) // branch-free: the count decides
+  {
+    const double* p = xyz + 3 * s;
+    const double dx = p[0] - x[0], dy = p[1] - x[1], dz = p[2] - x[2];
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (dist2 != nullptr)
+    {
+      dist2[count] = d2;
+    }
+    pos[count] = s;
+    count += d2 <= cut ? 1 : 0;
+  }
+  return count;
+}
+
 int FilterScalar(const double* xyz, const CellRange* ranges, int rangeCount, const double x[3], double cut,
   double* dist2, Index* pos)
 {
   int count = 0;
   for (int r = 0; r < rangeCount; ++r)
   {
-    for (Index s = ranges[r].Begin; s < ranges[r].End; ++s) // branch-free: the count decides
-    {
-      const double* p = xyz + 3 * s;
-      const double dx = p[0] - x[0], dy = p[1] - x[1], dz = p[2] - x[2];
-      const double d2 = dx * dx + dy * dy + dz * dz;
-      if (dist2 != nullptr)
-      {
-        dist2[count] = d2;
-      }
-      pos[count] = s;
-      count += d2 <= cut ? 1 : 0;
-    }
+    count = FilterSpan(xyz, ranges[r].Begin, ranges[r].End, x, cut, dist2, pos, count);
   }
   return count;
 }
@@ -307,18 +315,7 @@ __attribute__((target("avx2"))) int FilterAvx2(const double* xyz, const CellRang
         count += (keep >> lane) & 1;
       }
     }
-    for (; s < end; ++s)
-    {
-      const double* p = xyz + 3 * s;
-      const double dx = p[0] - x[0], dy = p[1] - x[1], dz = p[2] - x[2];
-      const double d2 = dx * dx + dy * dy + dz * dz;
-      if (dist2 != nullptr)
-      {
-        dist2[count] = d2;
-      }
-      pos[count] = s;
-      count += d2 <= cut ? 1 : 0;
-    }
+    count = FilterSpan(xyz, s, end, x, cut, dist2, pos, count);
   }
   return count;
 }

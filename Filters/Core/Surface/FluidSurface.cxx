@@ -3,6 +3,8 @@
 // (FluidSurface.h).
 #include "Surface/FluidSurface.h"
 
+#include "Common/Statistics.h"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -15,16 +17,6 @@ namespace
 {
 constexpr double Pi = 3.141592653589793238462643383279502884;
 
-double Median(std::vector<double> v)
-{
-  if (v.empty())
-  {
-    return 0.0;
-  }
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
 } // namespace
 
 bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes, const FluidSurfaceOptions& options)

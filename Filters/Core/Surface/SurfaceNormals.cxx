@@ -3,6 +3,7 @@
 #include "Surface/SurfaceNormals.h"
 
 #include "Common/LocalFit.h"
+#include "Common/Statistics.h"
 
 #include <Eigen/Dense>
 
@@ -148,16 +149,6 @@ LocalPCA PrincipalAxes(
   return out;
 }
 
-double Median(std::vector<double> v)
-{
-  if (v.empty())
-  {
-    return 0.0;
-  }
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
 
 /// From a radius query's result (sorted positions `pos`, squared distances `r2`) around a point: the distance
 /// to its k-th nearest other point and its `degree` nearest others (original indices, ordered by (distance,
