@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Montage of the demo's thesis figures for the README (one small PNG).
+"""Montages of the demo's pictures for the README (small PNGs): the thesis figures, and surface reconstruction.
 
 Usage: python3 Testing/Benchmarks/make_readme_figures.py [DEMO_DIR] [OUT_PNG]
-DEMO_DIR defaults to build/demo (written by ./run.sh demo); OUT_PNG to Testing/Benchmarks/results/demo_figures.png.
-Needs Debian's python3-matplotlib.
+DEMO_DIR defaults to build/demo (written by ./run.sh demo); OUT_PNG to Testing/Benchmarks/results/demo_figures.png;
+the surface montage goes beside it as surface_figures.png. Needs Debian's python3-matplotlib.
 """
 import os
 import sys
@@ -27,23 +27,34 @@ PANELS = [
     ("dambreak_005.png", "3D dam break (demo)"),
 ]
 
+SURFACE_PANELS = [
+    ("scan_points.png", "scan: 3,000 points, estimated outward normals"),
+    ("scan_surface.png", "its surface, coloured by the scan's intensity"),
+    ("dambreak_surface_005.png", "3D dam break as an SPH surface, coloured by speed"),
+]
 
-def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    root = os.path.dirname(os.path.dirname(here))
-    demo = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build", "demo")
-    out = sys.argv[2] if len(sys.argv) > 2 else os.path.join(here, "results", "demo_figures.png")
-    missing = [f for f, _ in PANELS if not os.path.isfile(os.path.join(demo, f))]
+
+def montage(demo, panels, out, rows, columns, size):
+    missing = [f for f, _ in panels if not os.path.isfile(os.path.join(demo, f))]
     if missing:
         sys.exit("missing demo pictures in %s (run ./run.sh demo first): %s" % (demo, ", ".join(missing)))
-    fig, axes = plt.subplots(2, 5, figsize=(15, 5.4))
-    for ax, (name, title) in zip(axes.flat, PANELS):
+    fig, axes = plt.subplots(rows, columns, figsize=size)
+    for ax, (name, title) in zip(axes.flat, panels):
         ax.imshow(mpimg.imread(os.path.join(demo, name)))
         ax.set_title(title, fontsize=9)
         ax.axis("off")
     fig.tight_layout()
     fig.savefig(out, dpi=80)
     print("wrote", out)
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(os.path.dirname(here))
+    demo = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build", "demo")
+    out = sys.argv[2] if len(sys.argv) > 2 else os.path.join(here, "results", "demo_figures.png")
+    montage(demo, PANELS, out, 2, 5, (15, 5.4))
+    montage(demo, SURFACE_PANELS, os.path.join(os.path.dirname(out), "surface_figures.png"), 1, 3, (15, 3.6))
 
 
 if __name__ == "__main__":
