@@ -358,6 +358,11 @@ bool EstimateNormals(
   }
   const double noiseRadius = field.Scale.Radius;
   const int k = std::max(std::max(3, options.NeighborCount), degree);
+  // Where the density sets the radius: one query a little wider than the typical r_k usually holds the k
+  // nearest, which saves the k-nearest search (a third of the normals' time on noise-free clouds).
+  const double densityRadius = fixed || noiseRadius > 0.0
+    ? 0.0
+    : 1.1 * field.Scale.Spacing / std::sqrt(Pi / std::max(3, options.NeighborCount));
   const double* sorted = grid.SortedPoints();
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
@@ -379,9 +384,9 @@ bool EstimateNormals(
         const Index id = order[s];
         const double* x = sorted + 3 * s;
         std::int32_t* row = &field.Graph[static_cast<size_t>(id) * degree];
-        // Where the noise radius holds more than k neighbours, the k nearest are among them: one radius
-        // query gives the neighbourhood, r_k and the orientation graph. Otherwise a k-nearest query first.
-        const double first = fixed ? options.SupportRadius : noiseRadius;
+        // Where the noise (or density) radius holds more than k neighbours, the k nearest are among them: one
+        // radius query gives the neighbourhood, r_k and the orientation graph. Otherwise a k-nearest query.
+        const double first = fixed ? options.SupportRadius : noiseRadius > 0.0 ? noiseRadius : densityRadius;
         if (first > 0.0)
         {
           grid.FindWithinRadiusPositions(x, first, pos, r2);
@@ -403,6 +408,23 @@ bool EstimateNormals(
             radius = std::max(field.NeighborDistance[id], noiseRadius);
             grid.FindWithinRadiusPositions(x, radius, pos, r2);
           }
+        }
+        else if (densityRadius > 0.0)
+        {
+          // The neighbourhood is the points within r_k, as a query at r_k would give them.
+          radius = field.NeighborDistance[id];
+          const double cut = radius * radius;
+          size_t kept = 0;
+          for (size_t j = 0; j < pos.size(); ++j)
+          {
+            if (r2[j] <= cut)
+            {
+              pos[kept] = pos[j];
+              r2[kept++] = r2[j];
+            }
+          }
+          pos.resize(kept);
+          r2.resize(kept);
         }
         // Where the noise sets the radius, the quadric's exactness is below the noise's tilt: PCA suffices.
         const bool jet = fixed || !(noiseRadius > field.NeighborDistance[id]);
