@@ -12,97 +12,43 @@ namespace meshfree
 
 namespace
 {
-/// Binary min-heap of point indices keyed by cost, with decrease-key (each point at most once).
-class IndexedHeap
+/// Monotone-enough priority queue for Prim's propagation: costs 1 - |cos| in [0, 1] fall into buckets
+/// uniform in sqrt(cost) (about the angle: 1024 buckets, 0.08 degrees each near 0), popped lowest first.
+/// Lowering a key pushes the point again; the caller skips points already taken (lazy deletion). Against a
+/// binary heap: O(1) per operation, and the same tree up to the order of edges within one bucket.
+class BucketQueue
 {
 public:
-  explicit IndexedHeap(Index n)
-    : Where(static_cast<size_t>(n), -1)
+  static constexpr int Buckets = 1024;
+  BucketQueue()
+    : Bucket(Buckets)
   {
   }
-  bool Empty() const { return this->Items.empty(); }
-  /// Inserts i or lowers its key.
-  void Push(std::int32_t i, float key)
+  bool Empty() const { return this->Queued == 0; }
+  void Push(std::int32_t i, float cost)
   {
-    if (this->Where[i] < 0)
-    {
-      this->Items.push_back(Item{ key, i });
-      this->Where[i] = static_cast<std::int32_t>(this->Items.size() - 1);
-    }
-    else
-    {
-      this->Items[this->Where[i]].Key = key;
-    }
-    this->Up(this->Where[i]);
+    const double r = std::sqrt(std::max(0.0, static_cast<double>(cost)));
+    const int b = std::min(Buckets - 1, static_cast<int>(r * Buckets));
+    this->Bucket[b].push_back(i);
+    this->Lowest = std::min(this->Lowest, b);
+    ++this->Queued;
   }
   std::int32_t Pop()
   {
-    const std::int32_t top = this->Items[0].Id;
-    this->Where[top] = -1;
-    const Item last = this->Items.back();
-    this->Items.pop_back();
-    if (!this->Items.empty())
+    while (this->Bucket[this->Lowest].empty())
     {
-      this->Items[0] = last;
-      this->Where[last.Id] = 0;
-      this->Down(0);
+      ++this->Lowest;
     }
-    return top;
+    const std::int32_t i = this->Bucket[this->Lowest].back();
+    this->Bucket[this->Lowest].pop_back();
+    --this->Queued;
+    return i;
   }
 
 private:
-  struct Item
-  {
-    float Key;
-    std::int32_t Id;
-    bool operator<(const Item& o) const { return this->Key != o.Key ? this->Key < o.Key : this->Id < o.Id; }
-  };
-  void Place(std::int32_t slot, const Item& item)
-  {
-    this->Items[slot] = item;
-    this->Where[item.Id] = slot;
-  }
-  void Up(std::int32_t slot)
-  {
-    const Item item = this->Items[slot];
-    while (slot > 0)
-    {
-      const std::int32_t parent = (slot - 1) / 2;
-      if (!(item < this->Items[parent]))
-      {
-        break;
-      }
-      this->Place(slot, this->Items[parent]);
-      slot = parent;
-    }
-    this->Place(slot, item);
-  }
-  void Down(std::int32_t slot)
-  {
-    const Item item = this->Items[slot];
-    const std::int32_t size = static_cast<std::int32_t>(this->Items.size());
-    for (;;)
-    {
-      std::int32_t child = 2 * slot + 1;
-      if (child >= size)
-      {
-        break;
-      }
-      if (child + 1 < size && this->Items[child + 1] < this->Items[child])
-      {
-        ++child;
-      }
-      if (!(this->Items[child] < item))
-      {
-        break;
-      }
-      this->Place(slot, this->Items[child]);
-      slot = child;
-    }
-    this->Place(slot, item);
-  }
-  std::vector<Item> Items;
-  std::vector<std::int32_t> Where;
+  std::vector<std::vector<std::int32_t>> Bucket;
+  int Lowest = 0;
+  size_t Queued = 0;
 };
 
 inline double Dot(const double* a, const double* b)
@@ -205,7 +151,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   std::vector<std::int32_t> parent(static_cast<size_t>(nv), -1);
   std::vector<float> key(static_cast<size_t>(nv), std::numeric_limits<float>::infinity());
   std::vector<std::int32_t> members;
-  IndexedHeap heap(nv);
+  BucketQueue heap;
   for (Index seed = 0; seed < nv; ++seed)
   {
     if (!valid[seed] || done[seed])
@@ -219,6 +165,10 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     while (!heap.Empty())
     {
       const std::int32_t u = heap.Pop();
+      if (done[u])
+      {
+        continue; // an entry left behind when its key was lowered
+      }
       done[u] = 1;
       members.push_back(u);
       double* nu = &normals[3 * u];
