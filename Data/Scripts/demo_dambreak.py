@@ -9,16 +9,10 @@ follows the time). About 1,300 adaptive steps: two to three minutes on two cores
 """
 import argparse
 import os
-import sys
 
 from paraview import simple
 
-
-def load_plugin(namespace):
-    path = os.environ.get("MESHFREE_PLUGIN")
-    if not path or not os.path.exists(path):
-        sys.exit("set MESHFREE_PLUGIN to build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so")
-    simple.LoadPlugin(path, remote=False, ns=namespace)
+from demo_common import load_plugin, new_view
 
 
 def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
@@ -32,14 +26,7 @@ def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
                      EndTime=end_time, OutputInterval=interval)
     tank = simple.Box(XLength=domain[1] - domain[0], YLength=domain[3] - domain[2], ZLength=domain[5] - domain[4],
                       Center=[(domain[0] + domain[1]) / 2, (domain[2] + domain[3]) / 2, (domain[4] + domain[5]) / 2])
-    view = simple.CreateRenderView()
-    view.ViewSize = list(size)
-    view.OrientationAxesVisibility = 0
-    view.Background = [1, 1, 1]
-    try:
-        view.UseColorPaletteForBackground = 0
-    except AttributeError:
-        pass
+    view = new_view(size)
     outline = simple.Show(tank, view)
     outline.SetRepresentationType("Outline")
     outline.AmbientColor = outline.DiffuseColor = [0.2, 0.2, 0.2]

@@ -14,30 +14,12 @@ the scanners never saw a band at the bottom of the inner side). Pictures:
 """
 import argparse
 import os
-import sys
 
 from paraview import simple
 
+from demo_common import load_plugin, new_view
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-
-
-def load_plugin(namespace):
-    path = os.environ.get("MESHFREE_PLUGIN")
-    if not path or not os.path.exists(path):
-        sys.exit("set MESHFREE_PLUGIN to build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so")
-    simple.LoadPlugin(path, remote=False, ns=namespace)
-
-
-def new_view(size):
-    view = simple.CreateRenderView()
-    view.ViewSize = list(size)
-    view.OrientationAxesVisibility = 0
-    view.Background = [1, 1, 1]
-    try:
-        view.UseColorPaletteForBackground = 0
-    except AttributeError:
-        pass
-    return view
 
 
 def frame(view):
