@@ -1,4 +1,5 @@
 #include "vtkMeshlessApproximation.h"
+#include "vtkMeshFreeFilterSupport.h"
 
 #include "vtkAlgorithmOutput.h"
 #include "vtkCharArray.h"
@@ -438,10 +439,7 @@ int vtkMeshlessApproximation::RequestData(
   out.Valid = validOut.data();
   out.NeighborCounts = this->Diagnostics ? countValues.data() : nullptr;
   out.Conditions = this->Diagnostics ? conditionValues.data() : nullptr;
-  const bool done = approx.Evaluate(eval.data(), m, out, [this](double fraction) {
-    this->UpdateProgress(fraction);
-    return !this->GetAbortExecute();
-  });
+  const bool done = approx.Evaluate(eval.data(), m, out, vtkMeshFreeFilterSupport::Progress(this));
   const meshfree::ApproximationReport& report = approx.Report();
   if (!done && !report.Aborted && valid > 0)
   {

@@ -1,4 +1,5 @@
 #include "vtkMeshlessNormals.h"
+#include "vtkMeshFreeFilterSupport.h"
 
 #include "vtkCharArray.h"
 #include "vtkDataArray.h"
@@ -14,10 +15,12 @@
 #include "vtkPoints.h"
 #include "vtkSmartPointer.h"
 
+#include "Common/Statistics.h"
 #include "Surface/CloudNormals.h"
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 vtkStandardNewMacro(vtkMeshlessNormals);
@@ -46,15 +49,6 @@ vtkSmartPointer<vtkDoubleArray> NewArray(const char* name, int components, const
   return array;
 }
 
-void AddFieldValue(vtkFieldData* fd, const char* name, double value)
-{
-  vtkNew<vtkDoubleArray> array;
-  array->SetName(name);
-  array->SetNumberOfTuples(1);
-  array->SetValue(0, value);
-  fd->AddArray(array);
-}
-
 /// Median of the values whose mask is set (0 when none is).
 double MaskedMedian(const std::vector<double>& values, const std::vector<unsigned char>& mask)
 {
@@ -66,12 +60,7 @@ double MaskedMedian(const std::vector<double>& values, const std::vector<unsigne
       kept.push_back(values[i]);
     }
   }
-  if (kept.empty())
-  {
-    return 0.0;
-  }
-  std::nth_element(kept.begin(), kept.begin() + kept.size() / 2, kept.end());
-  return kept[kept.size() / 2];
+  return meshfree::Median(std::move(kept));
 }
 } // namespace
 
@@ -139,10 +128,7 @@ int vtkMeshlessNormals::RequestData(
   options.ProjectionIterations = this->ProjectionIterations;
   meshfree::CloudNormalsResult result;
   const bool done = meshfree::ComputeCloudNormals(xyz.data(), n, useReference ? reference.data() : nullptr,
-    options, result, [this](double fraction) {
-      this->UpdateProgress(fraction);
-      return !this->GetAbortExecute();
-    });
+    options, result, vtkMeshFreeFilterSupport::Progress(this));
   if (!done || result.Aborted)
   {
     output->Initialize();
@@ -192,8 +178,8 @@ int vtkMeshlessNormals::RequestData(
   pd->SetActiveScalars(this->ComputeCurvature ? "Curvature" : "OrientationConfidence");
 
   vtkFieldData* fd = output->GetFieldData();
-  AddFieldValue(fd, "NoiseEstimate", result.Scale.Noise);
-  AddFieldValue(fd, "SupportRadius", MaskedMedian(result.Radius, result.Valid));
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "NoiseEstimate", result.Scale.Noise);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "SupportRadius", MaskedMedian(result.Radius, result.Valid));
   vtkNew<vtkIdTypeArray> ambiguous;
   ambiguous->SetName("AmbiguousOrientations");
   ambiguous->InsertNextValue(static_cast<vtkIdType>(result.Orientation.Ambiguous));

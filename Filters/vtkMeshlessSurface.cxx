@@ -1,4 +1,5 @@
 #include "vtkMeshlessSurface.h"
+#include "vtkMeshFreeFilterSupport.h"
 
 #include "vtkCellArray.h"
 #include "vtkCharArray.h"
@@ -53,24 +54,6 @@ namespace
 {
 const char* const kNormals = "Normals";
 const char* const kValidMask = "vtkValidPointMask";
-
-/// Reports the core's progress as the sub-range [begin, end] of the filter's, and passes the abort flag back.
-meshfree::ProgressCallback StageProgress(vtkAlgorithm* algorithm, double begin, double end)
-{
-  return [algorithm, begin, end](double fraction) {
-    algorithm->UpdateProgress(begin + (end - begin) * fraction);
-    return !algorithm->GetAbortExecute();
-  };
-}
-
-void AddFieldValue(vtkFieldData* fd, const char* name, double value)
-{
-  vtkNew<vtkDoubleArray> array;
-  array->SetName(name);
-  array->SetNumberOfTuples(1);
-  array->SetValue(0, value);
-  fd->AddArray(array);
-}
 
 /// Triangles as vtkPolyData: 64-bit offsets and connectivity, double points, unit outward `Normals`.
 void WrapMesh(const meshfree::SurfaceMesh& mesh, vtkPolyData* output)
@@ -286,7 +269,7 @@ void vtkMeshlessSurface::AddApproximatedArrays(
   meshfree::ApproximationOutput out;
   out.Values = results.data();
   out.Valid = valid.data();
-  approximator.Evaluate(result.Mesh.Points.data(), m, out, StageProgress(this, 0.9, 1.0));
+  approximator.Evaluate(result.Mesh.Points.data(), m, out, vtkMeshFreeFilterSupport::Progress(this, 0.9, 1.0));
   if (approximator.Report().Aborted)
   {
     result.Aborted = true;
@@ -398,7 +381,7 @@ int vtkMeshlessSurface::RequestData(
   options.ProjectVertices = this->ProjectVertices;
   Result result;
   std::string error;
-  if (!meshfree::ReconstructSurface(in, options, result.Mesh, result.Report, error, StageProgress(this, 0.0, 0.9)))
+  if (!meshfree::ReconstructSurface(in, options, result.Mesh, result.Report, error, vtkMeshFreeFilterSupport::Progress(this, 0.0, 0.9)))
   {
     if (result.Report.Aborted)
     {
@@ -426,12 +409,12 @@ int vtkMeshlessSurface::RequestData(
   method->SetName("SurfaceMethod");
   method->InsertNextValue(meshfree::SurfaceMethodName(options.Method));
   fd->AddArray(method);
-  AddFieldValue(fd, "CellSize", result.Report.CellSize);
-  AddFieldValue(fd, "SupportRadius", result.Report.SupportRadius);
-  AddFieldValue(fd, "SetupSeconds", result.Report.SetupSeconds);
-  AddFieldValue(fd, "ContourSeconds", result.Report.ContourSeconds);
-  AddFieldValue(fd, "ProjectionSeconds", result.Report.ProjectionSeconds);
-  AddFieldValue(fd, "ApproximationSeconds", result.ApproximationSeconds);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "CellSize", result.Report.CellSize);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "SupportRadius", result.Report.SupportRadius);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "SetupSeconds", result.Report.SetupSeconds);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "ContourSeconds", result.Report.ContourSeconds);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "ProjectionSeconds", result.Report.ProjectionSeconds);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "ApproximationSeconds", result.ApproximationSeconds);
   return 1;
 }
 

@@ -107,9 +107,9 @@ void ChooseLattice(const NeighborGrid& grid, double cell, double margin, Contour
 
 /// Seed cells of the continuation: per occupied block of 4^3 lattice cells, its first chosen point is moved
 /// onto the surface (a few projection steps, at most `reach` away) and the cell it lands in is a seed; a point
-/// that cannot be projected, or where |f| >= `farther`, seeds nothing. Every piece of surface near the data gets many seeds, yet
-/// only the cells the surface crosses are evaluated (seeding every occupied cell would evaluate the whole
-/// noisy shell of points, several cells thick).
+/// that cannot be projected, or where |f| >= `farther` (when finite), seeds nothing. Every piece of surface
+/// near the data gets many seeds, yet only the cells the surface crosses are evaluated (seeding every
+/// occupied cell would evaluate the whole noisy shell of points, several cells thick).
 std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitField& field, const ContourOptions& lattice,
   double reach, const std::vector<unsigned char>& chosen, double farther = std::numeric_limits<double>::infinity())
 {
@@ -146,7 +146,7 @@ std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitFie
       const double* p = sorted + 3 * blocks[b].second;
       std::copy(p, p + 3, x);
       double f = 0.0;
-      if (!(farther == std::numeric_limits<double>::infinity()) && (!field.Evaluate(x, f, nullptr, scratch) || !(std::fabs(f) < farther)))
+      if (std::isfinite(farther) && (!field.Evaluate(x, f, nullptr, scratch) || !(std::fabs(f) < farther)))
       {
         continue; // far from the surface by the field's own measure (a particle deep in the fluid)
       }
