@@ -18,7 +18,7 @@ packages=(
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libexpat1-dev libboost-dev
   mpi-default-dev python3-mpi4py libx11-dev libgl-dev libdouble-conversion-dev zlib1g-dev
   libpython3-dev python3-dev xvfb xauth
-  libgtest-dev libbenchmark-dev liblzf-dev python3-numpy python3-scipy python3-matplotlib
+  libgtest-dev libbenchmark-dev liblzf-dev python3-numpy python3-scipy python3-matplotlib libtbb-dev
 )
 
 install_packages() {
