@@ -3,6 +3,7 @@
 // Usage: BenchApproximation [evaluations (default 1,000,000)]
 #include "TestFunctions.h"
 #include "Approximation/Approximation.h"
+#include "Common/Parallel.h"
 
 #include <chrono>
 #include <cmath>
@@ -10,9 +11,6 @@
 #include <cstdlib>
 #include <vector>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace
 {
@@ -45,16 +43,10 @@ int main(int argc, char* argv[])
   approx.SetCloud(xyz.data(), n, values.data(), 1);
   ApproximationOutput o;
   o.Values = out.data();
-#ifdef _OPENMP
-  const int maxThreads = omp_get_max_threads();
-#else
-  const int maxThreads = 1;
-#endif
+  const int maxThreads = meshfree::MaxThreads();
   for (int threads : { 1, maxThreads })
   {
-#ifdef _OPENMP
-    omp_set_num_threads(threads);
-#endif
+    meshfree::SetMaxThreads(threads);
     double best = 1e300;
     for (int repeat = 0; repeat < 3; ++repeat)
     {

@@ -2,10 +2,9 @@
 // (quadratic and linear gradient fits, with and without self-contact), and the cost and CG iterations of
 // implicit steps. Usage: BenchElasticSolid [lattice edge, default 46 -> 97,336 phyxels] [steps, default 20]
 // The thesis managed 299 phyxels at 7.3 steps/s (about 2,200 phyxel-steps/s, all-pairs neighbour search).
+#include "Common/Parallel.h"
 #include "Elastic/ElasticShapes.h"
 #include "Elastic/ElasticSolid.h"
-
-#include <omp.h>
 
 #include <chrono>
 #include <ctime>
@@ -54,7 +53,7 @@ int main(int argc, char* argv[])
 {
   const int edge = argc > 1 ? std::atoi(argv[1]) : 46;
   const int steps = argc > 2 ? std::atoi(argv[2]) : 20;
-  std::printf("threads: %d\n", omp_get_max_threads());
+  std::printf("threads: %s\n", ParallelBackend());
   for (int basis : { 2, 1 })
   {
     for (bool contacts : { true, false })

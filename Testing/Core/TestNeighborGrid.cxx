@@ -3,9 +3,9 @@
 // (distance, index) lists. The grid breaks distance ties by the original index, so the brute-force
 // reference (the first k of all points sorted by (distance, index)) is unique even with duplicates.
 #include "Common/NeighborGrid.h"
+#include "Common/Parallel.h"
 
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -790,10 +790,9 @@ TEST(NeighborGrid, AllPointsRadiusListsInParallelAndDegenerateInput)
   std::vector<Index> offsets, serialOffsets;
   std::vector<std::int32_t> rows, serialRows;
   ASSERT_TRUE(grid.FindWithinRadiusForAllPoints(0.04, offsets, rows, true));
-  const int threads = omp_get_max_threads();
-  omp_set_num_threads(1);
+  meshfree::SetMaxThreads(1);
   ASSERT_TRUE(grid.FindWithinRadiusForAllPoints(0.04, serialOffsets, serialRows, true));
-  omp_set_num_threads(threads);
+  meshfree::SetMaxThreads(0);
   EXPECT_EQ(offsets, serialOffsets);
   EXPECT_EQ(rows, serialRows);
   // A sample of rows against brute force.

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Common/NeighborGrid.h"
 
+#include "Common/Parallel.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
 #include <utility>
-
-#include <omp.h>
 
 #if defined(__GNUC__)
 #define MESHFREE_GRID_PREFETCH(address) __builtin_prefetch(address)
@@ -143,16 +143,20 @@ void RadixSort(std::uint64_t*& v, std::uint64_t*& scratch, Index m, int lowBit, 
     const int shift = lowBit + pass * digitBits;
     const std::uint64_t* in = v;
     std::uint64_t* out = scratch;
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-    for (int c = 0; c < chunks; ++c)
-    {
-      Index* count = offsets.data() + buckets * c;
-      std::fill(count, count + buckets, Index(0));
-      for (Index i = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); i < e; ++i)
+    ParallelFor(chunks,
+      1,
+      [&](Index begin, Index end)
       {
-        ++count[(in[i] >> shift) & mask];
-      }
-    }
+        for (int c = static_cast<int>(begin); c < end; ++c)
+        {
+          Index* count = offsets.data() + buckets * c;
+          std::fill(count, count + buckets, Index(0));
+          for (Index i = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); i < e; ++i)
+          {
+            ++count[(in[i] >> shift) & mask];
+          }
+        }
+      });
     Index sum = 0;
     bool oneBucket = false;
     for (std::size_t b = 0; b < buckets; ++b)
@@ -171,15 +175,19 @@ void RadixSort(std::uint64_t*& v, std::uint64_t*& scratch, Index m, int lowBit, 
     {
       continue;
     }
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-    for (int c = 0; c < chunks; ++c)
-    {
-      Index* next = offsets.data() + buckets * c;
-      for (Index i = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); i < e; ++i)
+    ParallelFor(chunks,
+      1,
+      [&](Index begin, Index end)
       {
-        out[next[(in[i] >> shift) & mask]++] = in[i];
-      }
-    }
+        for (int c = static_cast<int>(begin); c < end; ++c)
+        {
+          Index* next = offsets.data() + buckets * c;
+          for (Index i = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); i < e; ++i)
+          {
+            out[next[(in[i] >> shift) & mask]++] = in[i];
+          }
+        }
+      });
     std::swap(v, scratch);
   }
 }
@@ -380,36 +388,45 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
     return false;
   }
 
-  // Pass 1: bounds and number of valid points, per chunk (pass 2 compacts with the same chunks).
-  const int chunks = n >= ParallelThreshold ? std::max(1, omp_get_max_threads()) : 1;
+  // Pass 1: bounds and number of valid points, per chunk (pass 2 compacts with the same chunks). Chunks of at
+  // least 32,768 points, several per thread so that running threads take a descheduled one's chunks; the
+  // results do not depend on their number.
+  const int chunks =
+    n >= ParallelThreshold
+      ? static_cast<int>(std::min<Index>(std::max<Index>(n / 32768, 1), 8 * static_cast<Index>(MaxThreads())))
+      : 1;
   std::vector<Index> validBefore(chunks + 1, 0);
   std::vector<double> chunkBounds(6 * chunks);
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-  for (int c = 0; c < chunks; ++c)
-  {
-    double lo[3] = { Infinity, Infinity, Infinity };
-    double hi[3] = { -Infinity, -Infinity, -Infinity };
-    Index valid = 0;
-    for (Index i = ChunkBegin(n, c, chunks), e = ChunkBegin(n, c + 1, chunks); i < e; ++i)
+  ParallelFor(chunks,
+    1,
+    [&](Index begin, Index end)
     {
-      const double* p = xyz + 3 * i;
-      if (IsFinite3(p))
+      for (int c = static_cast<int>(begin); c < end; ++c)
       {
-        ++valid;
+        double lo[3] = { Infinity, Infinity, Infinity };
+        double hi[3] = { -Infinity, -Infinity, -Infinity };
+        Index valid = 0;
+        for (Index i = ChunkBegin(n, c, chunks), e = ChunkBegin(n, c + 1, chunks); i < e; ++i)
+        {
+          const double* p = xyz + 3 * i;
+          if (IsFinite3(p))
+          {
+            ++valid;
+            for (int a = 0; a < 3; ++a)
+            {
+              lo[a] = std::min(lo[a], p[a]);
+              hi[a] = std::max(hi[a], p[a]);
+            }
+          }
+        }
+        validBefore[c + 1] = valid;
         for (int a = 0; a < 3; ++a)
         {
-          lo[a] = std::min(lo[a], p[a]);
-          hi[a] = std::max(hi[a], p[a]);
+          chunkBounds[6 * c + 2 * a] = lo[a];
+          chunkBounds[6 * c + 2 * a + 1] = hi[a];
         }
       }
-    }
-    validBefore[c + 1] = valid;
-    for (int a = 0; a < 3; ++a)
-    {
-      chunkBounds[6 * c + 2 * a] = lo[a];
-      chunkBounds[6 * c + 2 * a + 1] = hi[a];
-    }
-  }
+    });
   double lo[3] = { Infinity, Infinity, Infinity };
   double hi[3] = { -Infinity, -Infinity, -Infinity };
   for (int c = 0; c < chunks; ++c)
@@ -498,26 +515,30 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   this->SortScratch.resize(m);
   std::vector<std::pair<std::uint64_t, Index>> pairs(packed ? 0 : m);
   std::uint64_t* keys = this->CellKeys.data();
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-  for (int c = 0; c < chunks; ++c)
-  {
-    Index out = validBefore[c];
-    for (Index i = ChunkBegin(n, c, chunks), e = ChunkBegin(n, c + 1, chunks); i < e; ++i)
+  ParallelFor(chunks,
+    1,
+    [&](Index begin, Index end)
     {
-      const double* p = xyz + 3 * i;
-      if (IsFinite3(p))
+      for (int c = static_cast<int>(begin); c < end; ++c)
       {
-        if (packed)
+        Index out = validBefore[c];
+        for (Index i = ChunkBegin(n, c, chunks), e = ChunkBegin(n, c + 1, chunks); i < e; ++i)
         {
-          keys[out++] = (cellKey(p) << keyShift) | static_cast<std::uint64_t>(i);
-        }
-        else
-        {
-          pairs[out++] = { cellKey(p), i };
+          const double* p = xyz + 3 * i;
+          if (IsFinite3(p))
+          {
+            if (packed)
+            {
+              keys[out++] = (cellKey(p) << keyShift) | static_cast<std::uint64_t>(i);
+            }
+            else
+            {
+              pairs[out++] = { cellKey(p), i };
+            }
+          }
         }
       }
-    }
-  }
+    });
   if (packed)
   {
     std::uint64_t* scratch = this->SortScratch.data();
@@ -538,32 +559,36 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   keys = this->CellKeys.data();
   Index* order = this->Order.data();
   double* sorted = this->Sorted.data();
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-  for (int c = 0; c < chunks; ++c)
-  {
-    for (Index s = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); s < e; ++s)
+  ParallelFor(chunks,
+    1,
+    [&](Index begin, Index end)
     {
-      Index i;
-      if (packed)
+      for (int c = static_cast<int>(begin); c < end; ++c)
       {
-        i = static_cast<Index>(keys[s] & idxMask);
-        keys[s] >>= keyShift;
-        if (s + 16 < e) // the reads are random for a cloud in random order: fetch ahead
+        for (Index s = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); s < e; ++s)
         {
-          MESHFREE_GRID_PREFETCH(xyz + 3 * static_cast<Index>(keys[s + 16] & idxMask));
+          Index i;
+          if (packed)
+          {
+            i = static_cast<Index>(keys[s] & idxMask);
+            keys[s] >>= keyShift;
+            if (s + 16 < e) // the reads are random for a cloud in random order: fetch ahead
+            {
+              MESHFREE_GRID_PREFETCH(xyz + 3 * static_cast<Index>(keys[s + 16] & idxMask));
+            }
+          }
+          else
+          {
+            i = pairs[s].second;
+            keys[s] = pairs[s].first;
+          }
+          order[s] = i;
+          sorted[3 * s] = xyz[3 * i];
+          sorted[3 * s + 1] = xyz[3 * i + 1];
+          sorted[3 * s + 2] = xyz[3 * i + 2];
         }
       }
-      else
-      {
-        i = pairs[s].second;
-        keys[s] = pairs[s].first;
-      }
-      order[s] = i;
-      sorted[3 * s] = xyz[3 * i];
-      sorted[3 * s + 1] = xyz[3 * i + 1];
-      sorted[3 * s + 2] = xyz[3 * i + 2];
-    }
-  }
+    });
 
   // Cell ranges: a run of equal keys is one cell.
   const Index cellCount = dims[0] * dims[1] * dims[2];
@@ -575,26 +600,36 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
       dims[0] *
       (AxisCell(p[1] - origin[1], inverse, dims[1]) + dims[1] * AxisCell(p[2] - origin[2], inverse, dims[2]));
   };
-#pragma omp parallel num_threads(chunks) if (chunks > 1)
-  {
-#pragma omp for schedule(static)
-    for (Index c = 0; c < cellCount; ++c)
+  const Index serialBelow = chunks > 1 ? 0 : std::max(cellCount, m) + 1;
+  ParallelFor(
+    cellCount,
+    16384,
+    [&](Index begin, Index end)
     {
-      cells[c] = CellRange{ 0, 0 };
-    }
-#pragma omp for schedule(static)
-    for (Index s = 0; s < m; ++s)
+      for (Index c = begin; c < end; ++c)
+      {
+        cells[c] = CellRange{ 0, 0 };
+      }
+    },
+    serialBelow);
+  ParallelFor(
+    m,
+    8192,
+    [&](Index begin, Index end)
     {
-      if (s == 0 || keys[s] != keys[s - 1])
+      for (Index s = begin; s < end; ++s)
       {
-        cells[linearCell(s)].Begin = s;
+        if (s == 0 || keys[s] != keys[s - 1])
+        {
+          cells[linearCell(s)].Begin = s;
+        }
+        if (s == m - 1 || keys[s] != keys[s + 1])
+        {
+          cells[linearCell(s)].End = s + 1;
+        }
       }
-      if (s == m - 1 || keys[s] != keys[s + 1])
-      {
-        cells[linearCell(s)].End = s + 1;
-      }
-    }
-  }
+    },
+    serialBelow);
   return true;
 }
 
@@ -1075,48 +1110,58 @@ Index NeighborGrid::FindDuplicates(std::vector<Index>& representative) const
   const Index* order = this->Order.data();
   Index duplicates = 0;
   // Equal coordinates fall into one cell: sort each cell's points by (x, y, z, index) and group.
-#pragma omp parallel reduction(+ : duplicates)
-  {
-    std::vector<Index> pos;
-#pragma omp for schedule(dynamic, 1024)
-    for (Index c = 0; c < cells; ++c)
+  std::vector<std::vector<Index>> posPerThread(MaxThreads());
+  duplicates = ParallelReduce(
+    cells,
+    1024,
+    Index(0),
+    [&](Index begin, Index end)
     {
-      const CellRange r = ranges[c];
-      if (r.End <= r.Begin)
+      std::vector<Index>& pos = posPerThread[ThreadIndex()];
+      Index found = 0; // this block's duplicates
+      for (Index c = begin; c < end; ++c)
       {
-        continue;
-      }
-      pos.clear();
-      for (Index s = r.Begin; s < r.End; ++s)
-      {
-        pos.push_back(s);
-      }
-      std::sort(pos.begin(), pos.end(), [xyz, order](Index a, Index b) {
-        for (int k = 0; k < 3; ++k)
+        const CellRange r = ranges[c];
+        if (r.End <= r.Begin)
         {
-          if (xyz[3 * a + k] != xyz[3 * b + k])
+          continue;
+        }
+        pos.clear();
+        for (Index s = r.Begin; s < r.End; ++s)
+        {
+          pos.push_back(s);
+        }
+        std::sort(pos.begin(),
+          pos.end(),
+          [xyz, order](Index a, Index b)
           {
-            return xyz[3 * a + k] < xyz[3 * b + k];
-          }
-        }
-        return order[a] < order[b];
-      });
-      Index first = pos[0];
-      representative[order[first]] = order[first];
-      for (size_t j = 1; j < pos.size(); ++j)
-      {
-        const Index s = pos[j];
-        const bool same = xyz[3 * s] == xyz[3 * first] && xyz[3 * s + 1] == xyz[3 * first + 1] &&
-          xyz[3 * s + 2] == xyz[3 * first + 2];
-        if (!same)
+            for (int k = 0; k < 3; ++k)
+            {
+              if (xyz[3 * a + k] != xyz[3 * b + k])
+              {
+                return xyz[3 * a + k] < xyz[3 * b + k];
+              }
+            }
+            return order[a] < order[b];
+          });
+        Index first = pos[0];
+        representative[order[first]] = order[first];
+        for (size_t j = 1; j < pos.size(); ++j)
         {
-          first = s;
+          const Index s = pos[j];
+          const bool same = xyz[3 * s] == xyz[3 * first] && xyz[3 * s + 1] == xyz[3 * first + 1] &&
+                            xyz[3 * s + 2] == xyz[3 * first + 2];
+          if (!same)
+          {
+            first = s;
+          }
+          representative[order[s]] = order[first];
+          found += same ? 1 : 0;
         }
-        representative[order[s]] = order[first];
-        duplicates += same ? 1 : 0;
       }
-    }
-  }
+      return found;
+    },
+    [](Index a, Index b) { return a + b; });
   return duplicates;
 }
 
@@ -1419,129 +1464,161 @@ bool NeighborGrid::FindWithinRadiusForAllPoints(
   const CellRange* cells = this->CellRanges.data();
   const Index nx = this->GridDims[0], ny = this->GridDims[1], nz = this->GridDims[2];
   const Index cellCount = nx * ny * nz;
-  const int threads = omp_get_max_threads();
-  // Scratch kept per thread between calls (repeated calls, e.g. every step of a simulation, then neither
-  // allocate nor touch fresh pages): per sorted position, where its row lies in its thread's buffer.
+  const int threads = MaxThreads();
+  // Scratch of the calling thread kept between calls (repeated calls, e.g. every step of a simulation, then
+  // neither allocate nor touch fresh pages): per sorted position, where its row lies in the buffer of the
+  // loop slot that found it; per slot, its rows back to back and the query's candidate cells and positions.
+  struct SlotScratch
+  {
+    detail::Buffer<std::int32_t> Rows;
+    std::size_t Used = 0;          // Rows.size() is the capacity in use; rows are written branch-free past Used
+    std::vector<CellRange> Ranges; // candidate cells of the current cell (neighbouring ranges merged)
+    detail::Buffer<Index> Pos;     // the filter's outputs
+  };
   thread_local detail::Buffer<Index> rowStart;
   thread_local detail::Buffer<std::int32_t> rowThread;
+  thread_local std::vector<SlotScratch> slots;
   rowStart.resize(static_cast<std::size_t>(valid));
   rowThread.resize(static_cast<std::size_t>(valid));
+  if (slots.size() < static_cast<std::size_t>(threads))
+  {
+    slots.resize(static_cast<std::size_t>(threads));
+  }
+  for (SlotScratch& slot : slots)
+  {
+    slot.Used = 0;
+  }
   Index* rowStartData = rowStart.data();
   std::int32_t* rowThreadData = rowThread.data();
-  std::vector<const std::int32_t*> buffers(static_cast<std::size_t>(threads), nullptr);
-#pragma omp parallel num_threads(threads) if (valid >= 4096)
-  {
-    const int t = omp_get_thread_num();
-    thread_local detail::Buffer<std::int32_t> out; // this thread's rows, back to back
-    std::size_t used = 0; // out.size() is the capacity in use; rows are written branch-free past `used`
-    // Candidate cells of the current cell (neighbouring ranges merged), and the filter's outputs.
-    thread_local std::vector<CellRange> ranges;
-    thread_local detail::Buffer<Index> pos;
-#pragma omp for schedule(dynamic, 64)
-    for (Index c = 0; c < cellCount; ++c)
+  SlotScratch* slotData = slots.data(); // thread_local names inside the loop's body would be the workers' own
+  ParallelFor(
+    cellCount,
+    64,
+    [&](Index begin, Index end)
     {
-      const CellRange own = cells[c];
-      if (own.End <= own.Begin)
+      const int t = ThreadIndex();
+      SlotScratch& slot = slotData[t];
+      detail::Buffer<std::int32_t>& out = slot.Rows;
+      std::size_t& used = slot.Used;
+      std::vector<CellRange>& ranges = slot.Ranges;
+      detail::Buffer<Index>& pos = slot.Pos;
+      for (Index c = begin; c < end; ++c)
       {
-        continue;
-      }
-      // The cells any of this cell's points can reach: the per-point range of VisitCells() for the box of
-      // the cell's points, visited in the same (z, y, x) order, so every row keeps FindWithinRadius()'s order
-      // (cells VisitCells() would prune hold no point within the radius).
-      double lo[3], hi[3];
-      for (int a = 0; a < 3; ++a)
-      {
-        lo[a] = hi[a] = xyz[3 * own.Begin + a] - this->Origin[a];
-      }
-      for (Index p = own.Begin + 1; p < own.End; ++p)
-      {
+        const CellRange own = cells[c];
+        if (own.End <= own.Begin)
+        {
+          continue;
+        }
+        // The cells any of this cell's points can reach: the per-point range of VisitCells() for the box of
+        // the cell's points, visited in the same (z, y, x) order, so every row keeps FindWithinRadius()'s order
+        // (cells VisitCells() would prune hold no point within the radius).
+        double lo[3], hi[3];
         for (int a = 0; a < 3; ++a)
         {
-          const double rel = xyz[3 * p + a] - this->Origin[a];
-          lo[a] = std::min(lo[a], rel);
-          hi[a] = std::max(hi[a], rel);
+          lo[a] = hi[a] = xyz[3 * own.Begin + a] - this->Origin[a];
         }
-      }
-      const double margin =
-        std::max(GapMargin(lo, this->Size, this->Extent), GapMargin(hi, this->Size, this->Extent));
-      Index first[3], last[3];
-      bool none = false;
-      for (int a = 0; a < 3; ++a)
-      {
-        const double top = static_cast<double>(this->GridDims[a] - 1);
-        const double low = std::floor((lo[a] - radius - margin) * this->InverseSize);
-        const double high = std::floor((hi[a] + radius + margin) * this->InverseSize);
-        none = none || low > top || high < 0.0;
-        first[a] = low > 0.0 ? static_cast<Index>(low) : 0;
-        last[a] = high < top ? static_cast<Index>(high) : this->GridDims[a] - 1;
-      }
-      ranges.clear();
-      Index total = 0;
-      for (Index k = first[2]; !none && k <= last[2]; ++k)
-      {
-        for (Index j = first[1]; j <= last[1]; ++j)
+        for (Index p = own.Begin + 1; p < own.End; ++p)
         {
-          const CellRange* row = cells + nx * (j + ny * k);
-          for (Index i = first[0]; i <= last[0]; ++i)
+          for (int a = 0; a < 3; ++a)
           {
-            const CellRange range = row[i];
-            if (range.End <= range.Begin)
+            const double rel = xyz[3 * p + a] - this->Origin[a];
+            lo[a] = std::min(lo[a], rel);
+            hi[a] = std::max(hi[a], rel);
+          }
+        }
+        const double margin =
+          std::max(GapMargin(lo, this->Size, this->Extent), GapMargin(hi, this->Size, this->Extent));
+        Index first[3], last[3];
+        bool none = false;
+        for (int a = 0; a < 3; ++a)
+        {
+          const double top = static_cast<double>(this->GridDims[a] - 1);
+          const double low = std::floor((lo[a] - radius - margin) * this->InverseSize);
+          const double high = std::floor((hi[a] + radius + margin) * this->InverseSize);
+          none = none || low > top || high < 0.0;
+          first[a] = low > 0.0 ? static_cast<Index>(low) : 0;
+          last[a] = high < top ? static_cast<Index>(high) : this->GridDims[a] - 1;
+        }
+        ranges.clear();
+        Index total = 0;
+        for (Index k = first[2]; !none && k <= last[2]; ++k)
+        {
+          for (Index j = first[1]; j <= last[1]; ++j)
+          {
+            const CellRange* row = cells + nx * (j + ny * k);
+            for (Index i = first[0]; i <= last[0]; ++i)
             {
-              continue;
-            }
-            total += range.End - range.Begin;
-            if (!ranges.empty() && ranges.back().End == range.Begin)
-            {
-              ranges.back().End = range.End;
-            }
-            else
-            {
-              ranges.push_back(range);
+              const CellRange range = row[i];
+              if (range.End <= range.Begin)
+              {
+                continue;
+              }
+              total += range.End - range.Begin;
+              if (!ranges.empty() && ranges.back().End == range.Begin)
+              {
+                ranges.back().End = range.End;
+              }
+              else
+              {
+                ranges.push_back(range);
+              }
             }
           }
         }
-      }
-      if (static_cast<Index>(pos.size()) < total + 8)
-      {
-        pos.resize(static_cast<std::size_t>(2 * total + 8));
-      }
-      for (Index p = own.Begin; p < own.End; ++p)
-      {
-        const int found = ranges.empty()
-          ? 0
-          : Filter(xyz, ranges.data(), static_cast<int>(ranges.size()), xyz + 3 * p, r2, nullptr, pos.data());
-        if (out.size() < used + static_cast<std::size_t>(found))
+        if (static_cast<Index>(pos.size()) < total + 8)
         {
-          out.resize(2 * (used + static_cast<std::size_t>(found)));
+          pos.resize(static_cast<std::size_t>(2 * total + 8));
         }
-        std::int32_t* row = out.data() + used;
-        std::size_t m = 0;
-        for (int q = 0; q < found; ++q) // branch-free: the count decides
+        for (Index p = own.Begin; p < own.End; ++p)
         {
-          row[m] = static_cast<std::int32_t>(order[pos[q]]);
-          m += static_cast<std::size_t>(!(excludeSelf && pos[q] == p));
+          const int found =
+            ranges.empty()
+              ? 0
+              : Filter(xyz, ranges.data(), static_cast<int>(ranges.size()), xyz + 3 * p, r2, nullptr, pos.data());
+          if (out.size() < used + static_cast<std::size_t>(found))
+          {
+            out.resize(2 * (used + static_cast<std::size_t>(found)));
+          }
+          std::int32_t* row = out.data() + used;
+          std::size_t m = 0;
+          for (int q = 0; q < found; ++q) // branch-free: the count decides
+          {
+            row[m] = static_cast<std::int32_t>(order[pos[q]]);
+            m += static_cast<std::size_t>(!(excludeSelf && pos[q] == p));
+          }
+          rowStartData[p] = static_cast<Index>(used);
+          rowThreadData[p] = t;
+          offsets[static_cast<std::size_t>(order[p]) + 1] = static_cast<Index>(m);
+          used += m;
         }
-        rowStartData[p] = static_cast<Index>(used);
-        rowThreadData[p] = t;
-        offsets[static_cast<std::size_t>(order[p]) + 1] = static_cast<Index>(m);
-        used += m;
       }
-    }
-    buffers[static_cast<std::size_t>(t)] = out.data();
+    },
+    valid >= 4096 ? 0 : cellCount + 1);
+  std::vector<const std::int32_t*> buffers(static_cast<std::size_t>(threads), nullptr);
+  for (int t = 0; t < threads; ++t)
+  {
+    buffers[static_cast<std::size_t>(t)] = slots[static_cast<std::size_t>(t)].Rows.data();
   }
   for (Index i = 0; i < n; ++i)
   {
     offsets[static_cast<std::size_t>(i) + 1] += offsets[static_cast<std::size_t>(i)];
   }
   ids.resize(static_cast<std::size_t>(offsets[static_cast<std::size_t>(n)]));
-#pragma omp parallel for schedule(static) if (valid >= 4096)
-  for (Index p = 0; p < valid; ++p)
-  {
-    const Index i = order[p];
-    const std::int32_t* from = buffers[static_cast<std::size_t>(rowThreadData[p])] + rowStartData[p];
-    std::copy(from, from + (offsets[static_cast<std::size_t>(i) + 1] - offsets[static_cast<std::size_t>(i)]),
-      ids.begin() + offsets[static_cast<std::size_t>(i)]);
-  }
+  ParallelFor(
+    valid,
+    1024,
+    [&](Index begin, Index end)
+    {
+      for (Index p = begin; p < end; ++p)
+      {
+        const Index i = order[p];
+        const std::int32_t* from = buffers[static_cast<std::size_t>(rowThreadData[p])] + rowStartData[p];
+        std::copy(from,
+          from + (offsets[static_cast<std::size_t>(i) + 1] - offsets[static_cast<std::size_t>(i)]),
+          ids.begin() + offsets[static_cast<std::size_t>(i)]);
+      }
+    },
+    4096);
   return true;
 }
 
@@ -1573,26 +1650,29 @@ void NeighborGrid::FindKNearestForAllPoints(
   const Index* order = this->Order.data();
   // In Morton order consecutive queries are neighbours: the previous k-th distance, slightly enlarged,
   // is a good first cut for the next query.
-#pragma omp parallel if (m >= 4096)
-  {
-    double cut = 0.0;
-#pragma omp for schedule(dynamic, 1024)
-    for (Index s = 0; s < m; ++s)
+  ParallelFor(
+    m,
+    1024,
+    [&](Index begin, Index end)
     {
-      const double* x = xyz + 3 * s;
-      double rel[3];
-      Index cq[3];
-      this->CellCoordinate(x, rel, cq);
-      Index* rowIds = idRows + order[s] * k;
-      double* rowDist2 = distRows + order[s] * k;
-      int found = this->NearestWithinEstimate(x, rel, cq, wanted, cut, rowIds, rowDist2);
-      if (found < 0)
+      double cut = 0.0;
+      for (Index s = begin; s < end; ++s)
       {
-        found = this->NearestExact(x, rel, cq, wanted, rowIds, rowDist2);
+        const double* x = xyz + 3 * s;
+        double rel[3];
+        Index cq[3];
+        this->CellCoordinate(x, rel, cq);
+        Index* rowIds = idRows + order[s] * k;
+        double* rowDist2 = distRows + order[s] * k;
+        int found = this->NearestWithinEstimate(x, rel, cq, wanted, cut, rowIds, rowDist2);
+        if (found < 0)
+        {
+          found = this->NearestExact(x, rel, cq, wanted, rowIds, rowDist2);
+        }
+        cut = found > 0 ? 1.25 * rowDist2[found - 1] : 0.0;
+        pad(order[s], found);
       }
-      cut = found > 0 ? 1.25 * rowDist2[found - 1] : 0.0;
-      pad(order[s], found);
-    }
-  }
+    },
+    4096);
 }
 } // namespace meshfree

@@ -10,7 +10,7 @@
  * through contiguous memory cell by cell; consecutive sorted points are spatial neighbours, so loops over
  * SortedOrder() are cache friendly too.
  *
- * Build is parallel (OpenMP), O(n): one pass for the bounds, one for the cell keys, an LSD radix sort of
+ * Build is parallel (Common/Parallel.h), O(n): one pass for the bounds, one for the cell keys, an LSD radix sort of
  * packed (cell key, index) words, a gather of the coordinates and a pass for the cell ranges.
  *
  * Geometry

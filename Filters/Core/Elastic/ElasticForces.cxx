@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Meshless elastic solid: deformation gradient from the MLS fit, Green strain, Hooke stress, and the elastic,
 // volume and hourglass forces in the momentum-conserving packet form (see ElasticSolid.h).
+#include "Common/Parallel.h"
 #include "Elastic/ElasticMath.h"
 #include "Elastic/ElasticSolid.h"
 
@@ -113,48 +114,54 @@ void ElasticSolid::ComputePackets(const double* x, std::vector<double>& packet, 
   Fout.resize(9 * n);
   selfForce.resize(3 * n);
   edge.resize(hourglass ? 3 * static_cast<size_t>(n) * k : 0);
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    double C[27], F[9];
-    this->Fit(x, i, C, F);
-    double E[6], S[6], Sm[9], Cof[9];
-    GreenStrain(F, E);
-    if (plastic)
+  ParallelFor(
+    n,
+    256,
+    [&](Index begin, Index end)
     {
-      for (int a = 0; a < 6; ++a)
+      for (Index i = begin; i < end; ++i)
       {
-        E[a] -= this->Current.PlasticStrain[6 * i + a];
+        double C[27], F[9];
+        this->Fit(x, i, C, F);
+        double E[6], S[6], Sm[9], Cof[9];
+        GreenStrain(F, E);
+        if (plastic)
+        {
+          for (int a = 0; a < 6; ++a)
+          {
+            E[a] -= this->Current.PlasticStrain[6 * i + a];
+          }
+        }
+        HookeStress(lambda, mu, E, S);
+        SymToMat(S, Sm);
+        Cofactor(F, Cof);
+        const double volumeTerm = kv * (Det3(F) - 1.0); // [4.24-4.25]
+        double* G = &packet[9 * i];
+        for (int a = 0; a < 3; ++a)
+        {
+          for (int b = 0; b < 3; ++b)
+          {
+            const double FS = F[a * 3] * Sm[b] + F[a * 3 + 1] * Sm[3 + b] + F[a * 3 + 2] * Sm[6 + b];
+            G[a * 3 + b] = this->Volume[i] * (FS + volumeTerm * Cof[a * 3 + b]); // v_i P_i [4.23]
+          }
+        }
+        const double* ds = &this->SelfShape[3 * i];
+        double self[3] = { 0.0, 0.0, 0.0 };
+        if (hourglass)
+        {
+          this->ResidualForces(x, i, C, &edge[3 * static_cast<size_t>(i) * k], self);
+        }
+        for (int a = 0; a < 3; ++a)
+        {
+          selfForce[3 * i + a] = self[a] - (G[a * 3] * ds[0] + G[a * 3 + 1] * ds[1] + G[a * 3 + 2] * ds[2]);
+        }
+        for (int a = 0; a < 9; ++a)
+        {
+          Fout[9 * i + a] = F[a];
+        }
       }
-    }
-    HookeStress(lambda, mu, E, S);
-    SymToMat(S, Sm);
-    Cofactor(F, Cof);
-    const double volumeTerm = kv * (Det3(F) - 1.0); // [4.24-4.25]
-    double* G = &packet[9 * i];
-    for (int a = 0; a < 3; ++a)
-    {
-      for (int b = 0; b < 3; ++b)
-      {
-        const double FS = F[a * 3] * Sm[b] + F[a * 3 + 1] * Sm[3 + b] + F[a * 3 + 2] * Sm[6 + b];
-        G[a * 3 + b] = this->Volume[i] * (FS + volumeTerm * Cof[a * 3 + b]); // v_i P_i [4.23]
-      }
-    }
-    const double* ds = &this->SelfShape[3 * i];
-    double self[3] = { 0.0, 0.0, 0.0 };
-    if (hourglass)
-    {
-      this->ResidualForces(x, i, C, &edge[3 * static_cast<size_t>(i) * k], self);
-    }
-    for (int a = 0; a < 3; ++a)
-    {
-      selfForce[3 * i + a] = self[a] - (G[a * 3] * ds[0] + G[a * 3 + 1] * ds[1] + G[a * 3 + 2] * ds[2]);
-    }
-    for (int a = 0; a < 9; ++a)
-    {
-      Fout[9 * i + a] = F[a];
-    }
-  }
+    },
+    kElasticParallel + 1);
 }
 
 void ElasticSolid::GatherForces(const std::vector<double>& packet, const std::vector<double>& selfForce,
@@ -164,31 +171,37 @@ void ElasticSolid::GatherForces(const std::vector<double>& packet, const std::ve
   const int k = this->K, nb = this->Basis;
   const bool hourglass = !edge.empty();
   f.resize(3 * n);
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index j = 0; j < n; ++j)
-  {
-    double acc[3] = { selfForce[3 * j], selfForce[3 * j + 1], selfForce[3 * j + 2] };
-    for (Index r = this->ReverseStart[j]; r < this->ReverseStart[j + 1]; ++r)
+  ParallelFor(
+    n,
+    512,
+    [&](Index begin, Index end)
     {
-      const Index e = this->ReverseEntry[r];
-      const Index i = e / k;
-      const double* G = &packet[9 * i];
-      const double* D = &this->Shape[e * nb];
-      const double invR = this->InvRadius[i];
-      const double d[3] = { D[0] * invR, D[1] * invR, D[2] * invR };
-      for (int a = 0; a < 3; ++a)
+      for (Index j = begin; j < end; ++j)
       {
-        acc[a] -= G[a * 3] * d[0] + G[a * 3 + 1] * d[1] + G[a * 3 + 2] * d[2];
-        if (hourglass)
+        double acc[3] = { selfForce[3 * j], selfForce[3 * j + 1], selfForce[3 * j + 2] };
+        for (Index r = this->ReverseStart[j]; r < this->ReverseStart[j + 1]; ++r)
         {
-          acc[a] -= edge[3 * e + a];
+          const Index e = this->ReverseEntry[r];
+          const Index i = e / k;
+          const double* G = &packet[9 * i];
+          const double* D = &this->Shape[e * nb];
+          const double invR = this->InvRadius[i];
+          const double d[3] = { D[0] * invR, D[1] * invR, D[2] * invR };
+          for (int a = 0; a < 3; ++a)
+          {
+            acc[a] -= G[a * 3] * d[0] + G[a * 3 + 1] * d[1] + G[a * 3 + 2] * d[2];
+            if (hourglass)
+            {
+              acc[a] -= edge[3 * e + a];
+            }
+          }
         }
+        f[3 * j] = acc[0];
+        f[3 * j + 1] = acc[1];
+        f[3 * j + 2] = acc[2];
       }
-    }
-    f[3 * j] = acc[0];
-    f[3 * j + 1] = acc[1];
-    f[3 * j + 2] = acc[2];
-  }
+    },
+    kElasticParallel + 1);
 }
 
 void ElasticSolid::ComputeInternalForces(const double* x, std::vector<double>& f) const
@@ -203,45 +216,55 @@ double ElasticSolid::InternalEnergy(const double* x) const
   const int k = this->K;
   const bool plastic = !this->Current.PlasticStrain.empty();
   double energy = 0.0;
-#pragma omp parallel for reduction(+ : energy) schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    double C[27], F[9], E[6];
-    this->Fit(x, i, C, F);
-    GreenStrain(F, E);
-    if (plastic)
+  energy += ParallelReduce(
+    n,
+    256,
+    decltype(energy)(0),
+    [&](Index begin, Index end)
     {
-      for (int a = 0; a < 6; ++a)
+      decltype(energy) energy = 0; // this block's part
+      for (Index i = begin; i < end; ++i)
       {
-        E[a] -= this->Current.PlasticStrain[6 * i + a];
-      }
-    }
-    const double tr = E[0] + E[1] + E[2];
-    const double EE = Norm6(E);
-    const double J1 = Det3(F) - 1.0;
-    const double psi =
-      0.5 * this->LameLambda * tr * tr + this->LameMu * EE * EE + 0.5 * this->Config.VolumeStiffness * J1 * J1;
-    double hg = 0.0;
-    if (this->Hourglass[i] > 0.0)
-    {
-      std::vector<double> edge(3 * k);
-      double self[3];
-      this->ResidualForces(x, i, C, edge.data(), self);
-      // edge = kappa w r, so sum |edge|^2 / (kappa w) = kappa sum w |r|^2
-      for (int t = 0; t < k && this->Neighbor[i * k + t] >= 0; ++t)
-      {
-        const double kw = this->Hourglass[i] * this->Weight[i * k + t];
-        if (kw > 0.0)
+        double C[27], F[9], E[6];
+        this->Fit(x, i, C, F);
+        GreenStrain(F, E);
+        if (plastic)
         {
-          for (int a = 0; a < 3; ++a)
+          for (int a = 0; a < 6; ++a)
           {
-            hg += edge[3 * t + a] * edge[3 * t + a] / kw;
+            E[a] -= this->Current.PlasticStrain[6 * i + a];
           }
         }
+        const double tr = E[0] + E[1] + E[2];
+        const double EE = Norm6(E);
+        const double J1 = Det3(F) - 1.0;
+        const double psi =
+          0.5 * this->LameLambda * tr * tr + this->LameMu * EE * EE + 0.5 * this->Config.VolumeStiffness * J1 * J1;
+        double hg = 0.0;
+        if (this->Hourglass[i] > 0.0)
+        {
+          std::vector<double> edge(3 * k);
+          double self[3];
+          this->ResidualForces(x, i, C, edge.data(), self);
+          // edge = kappa w r, so sum |edge|^2 / (kappa w) = kappa sum w |r|^2
+          for (int t = 0; t < k && this->Neighbor[i * k + t] >= 0; ++t)
+          {
+            const double kw = this->Hourglass[i] * this->Weight[i * k + t];
+            if (kw > 0.0)
+            {
+              for (int a = 0; a < 3; ++a)
+              {
+                hg += edge[3 * t + a] * edge[3 * t + a] / kw;
+              }
+            }
+          }
+        }
+        energy += this->Volume[i] * psi + 0.5 * hg;
       }
-    }
-    energy += this->Volume[i] * psi + 0.5 * hg;
-  }
+      return energy;
+    },
+    [](decltype(energy) a, decltype(energy) b) { return a + b; },
+    kElasticParallel + 1);
   return energy;
 }
 
@@ -255,20 +278,26 @@ void ElasticSolid::ComputeDeformation(std::vector<double>& Fs, std::vector<doubl
   detF.resize(n);
   const double* x = this->Current.Position.data();
   const bool plastic = !this->Current.PlasticStrain.empty();
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    double* F = &Fs[9 * i];
-    this->DeformationGradient(x, i, F);
-    double* E = &strain[6 * i];
-    GreenStrain(F, E);
-    double Ee[6];
-    for (int a = 0; a < 6; ++a)
+  ParallelFor(
+    n,
+    256,
+    [&](Index begin, Index end)
     {
-      Ee[a] = E[a] - (plastic ? this->Current.PlasticStrain[6 * i + a] : 0.0);
-    }
-    HookeStress(this->LameLambda, this->LameMu, Ee, &stress[6 * i]);
-    detF[i] = Det3(F);
-  }
+      for (Index i = begin; i < end; ++i)
+      {
+        double* F = &Fs[9 * i];
+        this->DeformationGradient(x, i, F);
+        double* E = &strain[6 * i];
+        GreenStrain(F, E);
+        double Ee[6];
+        for (int a = 0; a < 6; ++a)
+        {
+          Ee[a] = E[a] - (plastic ? this->Current.PlasticStrain[6 * i + a] : 0.0);
+        }
+        HookeStress(this->LameLambda, this->LameMu, Ee, &stress[6 * i]);
+        detF[i] = Det3(F);
+      }
+    },
+    kElasticParallel + 1);
 }
 } // namespace meshfree

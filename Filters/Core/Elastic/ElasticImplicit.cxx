@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Implicit integration of the meshless elastic solid: linearised backward Euler (M - dt^2 K) v+ = M v + dt F
 // [4.31-4.42], solved matrix-free by Jacobi-preconditioned conjugate gradients.
+#include "Common/Parallel.h"
 #include "Elastic/ElasticMath.h"
 #include "Elastic/ElasticSolid.h"
 
@@ -91,64 +92,70 @@ void ElasticSolid::ApplyHessian(
   packet.resize(9 * n);
   self.resize(3 * n);
   edge.resize(hourglass ? 3 * static_cast<size_t>(n) * k : 0);
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    double dC[27], dF[9];
-    this->Fit(dx, i, dC, dF);
-    const double* P = &this->NullProjector[i * 9];
-    for (int a = 0; a < 9; ++a)
+  ParallelFor(
+    n,
+    256,
+    [&](Index begin, Index end)
     {
-      dF[a] -= P[a]; // the gradient of dx alone
-    }
-    const double* F = &Fs[9 * i];
-    const double* Sp = &Splus[9 * i];
-    double FtdF[9], dS[9], Cof[9];
-    for (int a = 0; a < 3; ++a)
-    {
-      for (int b = 0; b < 3; ++b)
+      for (Index i = begin; i < end; ++i)
       {
-        FtdF[a * 3 + b] = F[a] * dF[b] + F[3 + a] * dF[3 + b] + F[6 + a] * dF[6 + b];
-      }
-    }
-    const double tr = FtdF[0] + FtdF[4] + FtdF[8];
-    for (int a = 0; a < 3; ++a)
-    {
-      for (int b = 0; b < 3; ++b)
-      {
-        dS[a * 3 + b] = mu * (FtdF[a * 3 + b] + FtdF[b * 3 + a]) + (a == b ? lambda * tr : 0.0);
-      }
-    }
-    elastic::Cofactor(F, Cof);
-    double cdF = 0.0;
-    for (int a = 0; a < 9; ++a)
-    {
-      cdF += Cof[a] * dF[a];
-    }
-    double* G = &packet[9 * i];
-    for (int a = 0; a < 3; ++a)
-    {
-      for (int b = 0; b < 3; ++b)
-      {
-        double v = kv * cdF * Cof[a * 3 + b];
-        for (int c = 0; c < 3; ++c)
+        double dC[27], dF[9];
+        this->Fit(dx, i, dC, dF);
+        const double* P = &this->NullProjector[i * 9];
+        for (int a = 0; a < 9; ++a)
         {
-          v += dF[a * 3 + c] * Sp[c * 3 + b] + F[a * 3 + c] * dS[c * 3 + b];
+          dF[a] -= P[a]; // the gradient of dx alone
         }
-        G[a * 3 + b] = this->Volume[i] * v;
+        const double* F = &Fs[9 * i];
+        const double* Sp = &Splus[9 * i];
+        double FtdF[9], dS[9], Cof[9];
+        for (int a = 0; a < 3; ++a)
+        {
+          for (int b = 0; b < 3; ++b)
+          {
+            FtdF[a * 3 + b] = F[a] * dF[b] + F[3 + a] * dF[3 + b] + F[6 + a] * dF[6 + b];
+          }
+        }
+        const double tr = FtdF[0] + FtdF[4] + FtdF[8];
+        for (int a = 0; a < 3; ++a)
+        {
+          for (int b = 0; b < 3; ++b)
+          {
+            dS[a * 3 + b] = mu * (FtdF[a * 3 + b] + FtdF[b * 3 + a]) + (a == b ? lambda * tr : 0.0);
+          }
+        }
+        elastic::Cofactor(F, Cof);
+        double cdF = 0.0;
+        for (int a = 0; a < 9; ++a)
+        {
+          cdF += Cof[a] * dF[a];
+        }
+        double* G = &packet[9 * i];
+        for (int a = 0; a < 3; ++a)
+        {
+          for (int b = 0; b < 3; ++b)
+          {
+            double v = kv * cdF * Cof[a * 3 + b];
+            for (int c = 0; c < 3; ++c)
+            {
+              v += dF[a * 3 + c] * Sp[c * 3 + b] + F[a * 3 + c] * dS[c * 3 + b];
+            }
+            G[a * 3 + b] = this->Volume[i] * v;
+          }
+        }
+        const double* ds = &this->SelfShape[3 * i];
+        double own[3] = { 0.0, 0.0, 0.0 };
+        if (hourglass)
+        {
+          this->ResidualForces(dx, i, dC, &edge[3 * static_cast<size_t>(i) * k], own);
+        }
+        for (int a = 0; a < 3; ++a)
+        {
+          self[3 * i + a] = own[a] - (G[a * 3] * ds[0] + G[a * 3 + 1] * ds[1] + G[a * 3 + 2] * ds[2]);
+        }
       }
-    }
-    const double* ds = &this->SelfShape[3 * i];
-    double own[3] = { 0.0, 0.0, 0.0 };
-    if (hourglass)
-    {
-      this->ResidualForces(dx, i, dC, &edge[3 * static_cast<size_t>(i) * k], own);
-    }
-    for (int a = 0; a < 3; ++a)
-    {
-      self[3 * i + a] = own[a] - (G[a * 3] * ds[0] + G[a * 3 + 1] * ds[1] + G[a * 3 + 2] * ds[2]);
-    }
-  }
+    },
+    kElasticParallel + 1);
   this->GatherForces(packet, self, edge, out);
 }
 
@@ -168,39 +175,45 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
   // Positive part of the elastic stress S at every phyxel (geometric stiffness kept semi-definite).
   std::vector<double> Splus(9 * n);
   const bool plastic = !this->Current.PlasticStrain.empty();
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    const double* F = &Fs[9 * i];
-    Eigen::Matrix3d Fm;
-    for (int a = 0; a < 3; ++a)
+  ParallelFor(
+    n,
+    256,
+    [&](Index begin, Index end)
     {
-      for (int b = 0; b < 3; ++b)
+      for (Index i = begin; i < end; ++i)
       {
-        Fm(a, b) = F[a * 3 + b];
+        const double* F = &Fs[9 * i];
+        Eigen::Matrix3d Fm;
+        for (int a = 0; a < 3; ++a)
+        {
+          for (int b = 0; b < 3; ++b)
+          {
+            Fm(a, b) = F[a * 3 + b];
+          }
+        }
+        Eigen::Matrix3d E = 0.5 * (Fm.transpose() * Fm - Eigen::Matrix3d::Identity());
+        if (plastic)
+        {
+          const double* p = &this->Current.PlasticStrain[6 * i];
+          Eigen::Matrix3d P;
+          P << p[0], p[3], p[5], p[3], p[1], p[4], p[5], p[4], p[2];
+          E -= P;
+        }
+        Eigen::Matrix3d S = this->LameLambda * E.trace() * Eigen::Matrix3d::Identity() + 2.0 * this->LameMu * E;
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+        eig.computeDirect(S);
+        const Eigen::Vector3d ev = eig.eigenvalues().cwiseMax(0.0);
+        const Eigen::Matrix3d Sp = eig.eigenvectors() * ev.asDiagonal() * eig.eigenvectors().transpose();
+        for (int a = 0; a < 3; ++a)
+        {
+          for (int b = 0; b < 3; ++b)
+          {
+            Splus[9 * i + a * 3 + b] = Sp(a, b);
+          }
+        }
       }
-    }
-    Eigen::Matrix3d E = 0.5 * (Fm.transpose() * Fm - Eigen::Matrix3d::Identity());
-    if (plastic)
-    {
-      const double* p = &this->Current.PlasticStrain[6 * i];
-      Eigen::Matrix3d P;
-      P << p[0], p[3], p[5], p[3], p[1], p[4], p[5], p[4], p[2];
-      E -= P;
-    }
-    Eigen::Matrix3d S = this->LameLambda * E.trace() * Eigen::Matrix3d::Identity() + 2.0 * this->LameMu * E;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(S);
-    const Eigen::Vector3d ev = eig.eigenvalues().cwiseMax(0.0);
-    const Eigen::Matrix3d Sp = eig.eigenvectors() * ev.asDiagonal() * eig.eigenvectors().transpose();
-    for (int a = 0; a < 3; ++a)
-    {
-      for (int b = 0; b < 3; ++b)
-      {
-        Splus[9 * i + a * 3 + b] = Sp(a, b);
-      }
-    }
-  }
+    },
+    kElasticParallel + 1);
 
   // (M (1 + dt damping) + dt^2 H) v+ = M v + dt f  [4.31-4.34]; pinned phyxels keep v = 0.
   const double* g = this->Config.Gravity;
@@ -232,15 +245,21 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
   }
   auto apply = [&](const std::vector<double>& in, std::vector<double>& result) {
     this->ApplyHessian(Fs, Splus, in.data(), result);
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-    for (Index i = 0; i < n; ++i)
-    {
-      for (int a = 0; a < 3; ++a)
+    ParallelFor(
+      n,
+      4096,
+      [&](Index begin, Index end)
       {
-        const Index c = 3 * i + a;
-        result[c] = this->IsFixed[i] ? in[c] : this->Mass[i] * md * in[c] - dt * dt * result[c];
-      }
-    }
+        for (Index i = begin; i < end; ++i)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            const Index c = 3 * i + a;
+            result[c] = this->IsFixed[i] ? in[c] : this->Mass[i] * md * in[c] - dt * dt * result[c];
+          }
+        }
+      },
+      kElasticParallel + 1);
   };
   std::vector<double> S;
   this->WallFilter(x, b.data(), S);
@@ -332,16 +351,22 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
     this->WorstResidual = std::max(this->WorstResidual, residual);
   }
 
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    for (int a = 0; a < 3; ++a)
+  ParallelFor(
+    n,
+    4096,
+    [&](Index begin, Index end)
     {
-      const Index c = 3 * i + a;
-      v[c] = this->IsFixed[i] ? 0.0 : sol[c];
-      x[c] = this->IsFixed[i] ? this->Rest[c] : x[c] + dt * v[c];
-    }
-  }
+      for (Index i = begin; i < end; ++i)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          const Index c = 3 * i + a;
+          v[c] = this->IsFixed[i] ? 0.0 : sol[c];
+          x[c] = this->IsFixed[i] ? this->Rest[c] : x[c] + dt * v[c];
+        }
+      }
+    },
+    kElasticParallel + 1);
   this->ApplyContainer(x, v);
   this->DefGrad = Fs;
   this->UpdatePlasticity(dt);

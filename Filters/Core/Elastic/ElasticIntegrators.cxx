@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Time integration of the meshless elastic solid: symplectic Euler [4.28-4.30], contacts [4.26], containers and
 // plasticity. The implicit integrator is in ElasticImplicit.cxx.
+#include "Common/Parallel.h"
 #include "Elastic/ElasticMath.h"
 #include "Elastic/ElasticSolid.h"
 
@@ -45,39 +46,44 @@ void ElasticSolid::AddContactForces(const double* x, std::vector<double>& f)
     }
   }
   this->ContactGrid.Build(this->ContactPositions.data(), m, reach);
-#pragma omp parallel if (m > kElasticParallel)
-  {
-    std::vector<Index> ids;
-    std::vector<double> d2;
-#pragma omp for schedule(dynamic, 256)
-    for (Index s = 0; s < m; ++s)
+  std::vector<std::vector<Index>> idsPerThread(MaxThreads());
+  std::vector<std::vector<double>> d2PerThread(MaxThreads());
+  ParallelFor(
+    m,
+    256,
+    [&](Index begin, Index end)
     {
-      const Index i = this->SurfacePhyxels[s];
-      this->ContactGrid.FindWithinRadius(x + 3 * i, reach, ids, &d2);
-      for (size_t t = 0; t < ids.size(); ++t)
+      std::vector<Index>& ids = idsPerThread[ThreadIndex()];
+      std::vector<double>& d2 = d2PerThread[ThreadIndex()];
+      for (Index s = begin; s < end; ++s)
       {
-        const Index j = this->SurfacePhyxels[ids[t]];
-        if (j == i || !(d2[t] > 0.0))
+        const Index i = this->SurfacePhyxels[s];
+        this->ContactGrid.FindWithinRadius(x + 3 * i, reach, ids, &d2);
+        for (size_t t = 0; t < ids.size(); ++t)
         {
-          continue;
-        }
-        // Rest neighbours are held by elasticity; only the others collide. The criterion is symmetric, so
-        // the pair forces are equal and opposite.
-        if (this->AreNeighbors(i, j) || this->AreNeighbors(j, i))
-        {
-          continue;
-        }
-        const double d = std::sqrt(d2[t]);
-        const double d6 = d2[t] * d2[t] * d2[t];
-        double L = 4.0 * beta * (12.0 * a12 / (d6 * d6 * d) - 6.0 * a6 / (d6 * d)); // [4.26]
-        L = std::min(std::max(L, 0.0), cap);
-        for (int a = 0; a < 3; ++a)
-        {
-          f[3 * i + a] += L * (x[3 * i + a] - x[3 * j + a]) / d;
+          const Index j = this->SurfacePhyxels[ids[t]];
+          if (j == i || !(d2[t] > 0.0))
+          {
+            continue;
+          }
+          // Rest neighbours are held by elasticity; only the others collide. The criterion is symmetric, so
+          // the pair forces are equal and opposite.
+          if (this->AreNeighbors(i, j) || this->AreNeighbors(j, i))
+          {
+            continue;
+          }
+          const double d = std::sqrt(d2[t]);
+          const double d6 = d2[t] * d2[t] * d2[t];
+          double L = 4.0 * beta * (12.0 * a12 / (d6 * d6 * d) - 6.0 * a6 / (d6 * d)); // [4.26]
+          L = std::min(std::max(L, 0.0), cap);
+          for (int a = 0; a < 3; ++a)
+          {
+            f[3 * i + a] += L * (x[3 * i + a] - x[3 * j + a]) / d;
+          }
         }
       }
-    }
-  }
+    },
+    kElasticParallel + 1);
 }
 
 void ElasticSolid::AddExternalForces(std::vector<double>& f) const
@@ -135,41 +141,47 @@ void ElasticSolid::ApplyContainer(double* x, double* v) const
       vel[a] = keep * vt[a] - e * vn * nrm[a];
     }
   };
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    double* p = x + 3 * i;
-    double* vel = v + 3 * i;
-    const int firstAxis = s.Container == ElasticContainer::Box ? 0 : 2;
-    for (int a = firstAxis; a < 3; ++a)
+  ParallelFor(
+    n,
+    2048,
+    [&](Index begin, Index end)
     {
-      double nrm[3] = { 0, 0, 0 };
-      if (p[a] < lo[a])
+      for (Index i = begin; i < end; ++i)
       {
-        p[a] = lo[a];
-        nrm[a] = 1.0;
-        collide(vel, nrm);
+        double* p = x + 3 * i;
+        double* vel = v + 3 * i;
+        const int firstAxis = s.Container == ElasticContainer::Box ? 0 : 2;
+        for (int a = firstAxis; a < 3; ++a)
+        {
+          double nrm[3] = { 0, 0, 0 };
+          if (p[a] < lo[a])
+          {
+            p[a] = lo[a];
+            nrm[a] = 1.0;
+            collide(vel, nrm);
+          }
+          else if (p[a] > hi[a])
+          {
+            p[a] = hi[a];
+            nrm[a] = -1.0;
+            collide(vel, nrm);
+          }
+        }
+        if (s.Container == ElasticContainer::Cylinder)
+        {
+          const double rx = p[0] - cx, ry = p[1] - cy;
+          const double r = std::sqrt(rx * rx + ry * ry);
+          if (r > R)
+          {
+            const double nrm[3] = { r > 0 ? -rx / r : -1.0, r > 0 ? -ry / r : 0.0, 0.0 };
+            p[0] = cx - nrm[0] * R;
+            p[1] = cy - nrm[1] * R;
+            collide(vel, nrm);
+          }
+        }
       }
-      else if (p[a] > hi[a])
-      {
-        p[a] = hi[a];
-        nrm[a] = -1.0;
-        collide(vel, nrm);
-      }
-    }
-    if (s.Container == ElasticContainer::Cylinder)
-    {
-      const double rx = p[0] - cx, ry = p[1] - cy;
-      const double r = std::sqrt(rx * rx + ry * ry);
-      if (r > R)
-      {
-        const double nrm[3] = { r > 0 ? -rx / r : -1.0, r > 0 ? -ry / r : 0.0, 0.0 };
-        p[0] = cx - nrm[0] * R;
-        p[1] = cy - nrm[1] * R;
-        collide(vel, nrm);
-      }
-    }
-  }
+    },
+    kElasticParallel + 1);
 }
 
 void ElasticSolid::UpdatePlasticity(double dt)
@@ -180,43 +192,49 @@ void ElasticSolid::UpdatePlasticity(double dt)
   }
   const ElasticSettings& s = this->Config;
   const double creep = std::min(1.0, dt * s.PlasticCreep);
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < this->N; ++i)
-  {
-    const double* F = &this->DefGrad[9 * i];
-    double* Ep = &this->Current.PlasticStrain[6 * i];
-    double C[6];
-    // Green strain of the last force evaluation, minus the plastic part: the elastic strain.
-    C[0] = 0.5 * (F[0] * F[0] + F[3] * F[3] + F[6] * F[6] - 1.0);
-    C[1] = 0.5 * (F[1] * F[1] + F[4] * F[4] + F[7] * F[7] - 1.0);
-    C[2] = 0.5 * (F[2] * F[2] + F[5] * F[5] + F[8] * F[8] - 1.0);
-    C[3] = 0.5 * (F[0] * F[1] + F[3] * F[4] + F[6] * F[7]);
-    C[4] = 0.5 * (F[1] * F[2] + F[4] * F[5] + F[7] * F[8]);
-    C[5] = 0.5 * (F[0] * F[2] + F[3] * F[5] + F[6] * F[8]);
-    double norm2 = 0.0;
-    for (int a = 0; a < 6; ++a)
+  ParallelFor(
+    this->N,
+    1024,
+    [&](Index begin, Index end)
     {
-      C[a] -= Ep[a];
-      norm2 += (a < 3 ? 1.0 : 2.0) * C[a] * C[a];
-    }
-    if (std::sqrt(norm2) > s.PlasticYield) // Mueller 2004 sec. 5: yield, creep
-    {
-      double pnorm2 = 0.0;
-      for (int a = 0; a < 6; ++a)
+      for (Index i = begin; i < end; ++i)
       {
-        Ep[a] += creep * C[a];
-        pnorm2 += (a < 3 ? 1.0 : 2.0) * Ep[a] * Ep[a];
-      }
-      const double pnorm = std::sqrt(pnorm2);
-      if (s.PlasticMaxStrain > 0.0 && pnorm > s.PlasticMaxStrain) // maximum plastic strain
-      {
+        const double* F = &this->DefGrad[9 * i];
+        double* Ep = &this->Current.PlasticStrain[6 * i];
+        double C[6];
+        // Green strain of the last force evaluation, minus the plastic part: the elastic strain.
+        C[0] = 0.5 * (F[0] * F[0] + F[3] * F[3] + F[6] * F[6] - 1.0);
+        C[1] = 0.5 * (F[1] * F[1] + F[4] * F[4] + F[7] * F[7] - 1.0);
+        C[2] = 0.5 * (F[2] * F[2] + F[5] * F[5] + F[8] * F[8] - 1.0);
+        C[3] = 0.5 * (F[0] * F[1] + F[3] * F[4] + F[6] * F[7]);
+        C[4] = 0.5 * (F[1] * F[2] + F[4] * F[5] + F[7] * F[8]);
+        C[5] = 0.5 * (F[0] * F[2] + F[3] * F[5] + F[6] * F[8]);
+        double norm2 = 0.0;
         for (int a = 0; a < 6; ++a)
         {
-          Ep[a] *= s.PlasticMaxStrain / pnorm;
+          C[a] -= Ep[a];
+          norm2 += (a < 3 ? 1.0 : 2.0) * C[a] * C[a];
+        }
+        if (std::sqrt(norm2) > s.PlasticYield) // Mueller 2004 sec. 5: yield, creep
+        {
+          double pnorm2 = 0.0;
+          for (int a = 0; a < 6; ++a)
+          {
+            Ep[a] += creep * C[a];
+            pnorm2 += (a < 3 ? 1.0 : 2.0) * Ep[a] * Ep[a];
+          }
+          const double pnorm = std::sqrt(pnorm2);
+          if (s.PlasticMaxStrain > 0.0 && pnorm > s.PlasticMaxStrain) // maximum plastic strain
+          {
+            for (int a = 0; a < 6; ++a)
+            {
+              Ep[a] *= s.PlasticMaxStrain / pnorm;
+            }
+          }
         }
       }
-    }
-  }
+    },
+    kElasticParallel + 1);
 }
 
 void ElasticSolid::StepSymplectic(double dt)
@@ -229,25 +247,31 @@ void ElasticSolid::StepSymplectic(double dt)
   this->AddExternalForces(this->Force);
   const double* g = this->Config.Gravity;
   const double damp = 1.0 / (1.0 + dt * this->Config.Damping);
-#pragma omp parallel for schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    if (this->IsFixed[i])
+  ParallelFor(
+    n,
+    4096,
+    [&](Index begin, Index end)
     {
-      for (int a = 0; a < 3; ++a)
+      for (Index i = begin; i < end; ++i)
       {
-        v[3 * i + a] = 0.0;
-        x[3 * i + a] = this->Rest[3 * i + a];
+        if (this->IsFixed[i])
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            v[3 * i + a] = 0.0;
+            x[3 * i + a] = this->Rest[3 * i + a];
+          }
+          continue;
+        }
+        const double invM = 1.0 / this->Mass[i];
+        for (int a = 0; a < 3; ++a) // [4.28-4.30]: velocity first, then position with the new velocity
+        {
+          v[3 * i + a] = (v[3 * i + a] + dt * (this->Force[3 * i + a] * invM + g[a])) * damp;
+          x[3 * i + a] += dt * v[3 * i + a];
+        }
       }
-      continue;
-    }
-    const double invM = 1.0 / this->Mass[i];
-    for (int a = 0; a < 3; ++a) // [4.28-4.30]: velocity first, then position with the new velocity
-    {
-      v[3 * i + a] = (v[3 * i + a] + dt * (this->Force[3 * i + a] * invM + g[a])) * damp;
-      x[3 * i + a] += dt * v[3 * i + a];
-    }
-  }
+    },
+    kElasticParallel + 1);
   this->ApplyContainer(x, v);
   this->UpdatePlasticity(dt);
   this->Current.Time += dt;

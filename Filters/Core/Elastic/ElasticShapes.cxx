@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Elastic/ElasticShapes.h"
 
+#include "Common/Parallel.h"
 #include "Elastic/ElasticSolid.h"
 
 #include <array>
@@ -238,33 +239,39 @@ void InsideMesh(const std::vector<double>& p, const std::vector<Index>& t, const
   const Index nq = static_cast<Index>(queries.size() / 3);
   inside.assign(nq, 0);
   const Index nt = static_cast<Index>(t.size() / 3);
-#pragma omp parallel for schedule(dynamic, 64) if (nq * nt > 1000000)
-  for (Index q = 0; q < nq; ++q)
-  {
-    const double* x = &queries[3 * q];
-    double omega = 0.0;
-    for (Index f = 0; f < nt; ++f)
+  ParallelFor(
+    nq,
+    64,
+    [&](Index begin, Index end)
     {
-      double a[3], b[3], c[3];
-      for (int k = 0; k < 3; ++k)
+      for (Index q = begin; q < end; ++q)
       {
-        a[k] = p[3 * t[3 * f] + k] - x[k];
-        b[k] = p[3 * t[3 * f + 1] + k] - x[k];
-        c[k] = p[3 * t[3 * f + 2] + k] - x[k];
+        const double* x = &queries[3 * q];
+        double omega = 0.0;
+        for (Index f = 0; f < nt; ++f)
+        {
+          double a[3], b[3], c[3];
+          for (int k = 0; k < 3; ++k)
+          {
+            a[k] = p[3 * t[3 * f] + k] - x[k];
+            b[k] = p[3 * t[3 * f + 1] + k] - x[k];
+            c[k] = p[3 * t[3 * f + 2] + k] - x[k];
+          }
+          const double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+          const double lb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+          const double lc = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+          const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                             a[2] * (b[0] * c[1] - b[1] * c[0]);
+          const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+          const double ac = a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
+          const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
+          // Van Oosterom & Strackee: solid angle of the triangle seen from x.
+          omega += 2.0 * std::atan2(det, la * lb * lc + ab * lc + ac * lb + bc * la);
+        }
+        inside[q] = std::fabs(omega) > 2.0 * Pi ? 1 : 0;
       }
-      const double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-      const double lb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-      const double lc = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-      const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-        a[2] * (b[0] * c[1] - b[1] * c[0]);
-      const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-      const double ac = a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
-      const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
-      // Van Oosterom & Strackee: solid angle of the triangle seen from x.
-      omega += 2.0 * std::atan2(det, la * lb * lc + ab * lc + ac * lb + bc * la);
-    }
-    inside[q] = std::fabs(omega) > 2.0 * Pi ? 1 : 0;
-  }
+    },
+    1000000 + 1);
 }
 
 void VertexNormals(const std::vector<double>& p, const std::vector<Index>& t, std::vector<double>& normals)
@@ -311,28 +318,33 @@ void ElasticSurface::Bind(const ElasticSolid& solid, const std::vector<double>& 
   }
   NeighborGrid grid;
   grid.Build(solid.RestPositions().data(), np);
-#pragma omp parallel if (nv > kElasticParallel)
-  {
-    std::vector<Index> ids;
-    std::vector<double> d2;
-#pragma omp for schedule(static)
-    for (Index v = 0; v < nv; ++v)
+  std::vector<std::vector<Index>> idsPerThread(MaxThreads());
+  std::vector<std::vector<double>> d2PerThread(MaxThreads());
+  ParallelFor(
+    nv,
+    256,
+    [&](Index begin, Index end)
     {
-      const int found = grid.FindKNearest(&this->RestVertices[3 * v], this->K, ids, d2);
-      double mean = 0.0;
-      for (int t = 0; t < found; ++t)
+      std::vector<Index>& ids = idsPerThread[ThreadIndex()];
+      std::vector<double>& d2 = d2PerThread[ThreadIndex()];
+      for (Index v = begin; v < end; ++v)
       {
-        mean += std::sqrt(d2[t]);
+        const int found = grid.FindKNearest(&this->RestVertices[3 * v], this->K, ids, d2);
+        double mean = 0.0;
+        for (int t = 0; t < found; ++t)
+        {
+          mean += std::sqrt(d2[t]);
+        }
+        mean = found > 0 ? mean / found : 1.0;
+        const double h2 = mean > 0.0 ? mean * mean : 1.0;
+        for (int t = 0; t < found; ++t)
+        {
+          this->Phyxel[v * this->K + t] = ids[t];
+          this->Weight[v * this->K + t] = std::exp(-d2[t] / h2); // [4.44]
+        }
       }
-      mean = found > 0 ? mean / found : 1.0;
-      const double h2 = mean > 0.0 ? mean * mean : 1.0;
-      for (int t = 0; t < found; ++t)
-      {
-        this->Phyxel[v * this->K + t] = ids[t];
-        this->Weight[v * this->K + t] = std::exp(-d2[t] / h2); // [4.44]
-      }
-    }
-  }
+    },
+    kElasticParallel + 1);
 }
 
 void ElasticSurface::Deform(const ElasticSolid& solid, const std::vector<double>& F, std::vector<double>& points,
@@ -343,35 +355,41 @@ void ElasticSurface::Deform(const ElasticSolid& solid, const std::vector<double>
   displacement.resize(3 * nv);
   const std::vector<double>& X = solid.RestPositions();
   const std::vector<double>& x = solid.State().Position;
-#pragma omp parallel for schedule(static) if (nv > kElasticParallel)
-  for (Index v = 0; v < nv; ++v)
-  {
-    const double* P = &this->RestVertices[3 * v];
-    double u[3] = { 0, 0, 0 }, wsum = 0.0;
-    for (int t = 0; t < this->K; ++t)
+  ParallelFor(
+    nv,
+    1024,
+    [&](Index begin, Index end)
     {
-      const Index i = this->Phyxel[v * this->K + t];
-      if (i < 0)
+      for (Index v = begin; v < end; ++v)
       {
-        continue;
+        const double* P = &this->RestVertices[3 * v];
+        double u[3] = { 0, 0, 0 }, wsum = 0.0;
+        for (int t = 0; t < this->K; ++t)
+        {
+          const Index i = this->Phyxel[v * this->K + t];
+          if (i < 0)
+          {
+            continue;
+          }
+          const double w = this->Weight[v * this->K + t];
+          const double* Fi = &F[9 * i];
+          const double r[3] = { P[0] - X[3 * i], P[1] - X[3 * i + 1], P[2] - X[3 * i + 2] };
+          for (int a = 0; a < 3; ++a) // [4.43]: u_i + grad u_i^T (x - X_i), grad u^T = F - I
+          {
+            const double ui = x[3 * i + a] - X[3 * i + a];
+            const double gu = (Fi[a * 3] * r[0] + Fi[a * 3 + 1] * r[1] + Fi[a * 3 + 2] * r[2]) - r[a];
+            u[a] += w * (ui + gu);
+          }
+          wsum += w;
+        }
+        for (int a = 0; a < 3; ++a)
+        {
+          displacement[3 * v + a] = wsum > 0.0 ? u[a] / wsum : 0.0;
+          points[3 * v + a] = P[a] + displacement[3 * v + a];
+        }
       }
-      const double w = this->Weight[v * this->K + t];
-      const double* Fi = &F[9 * i];
-      const double r[3] = { P[0] - X[3 * i], P[1] - X[3 * i + 1], P[2] - X[3 * i + 2] };
-      for (int a = 0; a < 3; ++a) // [4.43]: u_i + grad u_i^T (x - X_i), grad u^T = F - I
-      {
-        const double ui = x[3 * i + a] - X[3 * i + a];
-        const double gu = (Fi[a * 3] * r[0] + Fi[a * 3 + 1] * r[1] + Fi[a * 3 + 2] * r[2]) - r[a];
-        u[a] += w * (ui + gu);
-      }
-      wsum += w;
-    }
-    for (int a = 0; a < 3; ++a)
-    {
-      displacement[3 * v + a] = wsum > 0.0 ? u[a] / wsum : 0.0;
-      points[3 * v + a] = P[a] + displacement[3 * v + a];
-    }
-  }
+    },
+    kElasticParallel + 1);
 }
 
 } // namespace meshfree

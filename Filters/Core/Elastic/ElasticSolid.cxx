@@ -2,6 +2,7 @@
 // Meshless elastic solid (Mueller et al. 2004): model set-up, strain/stress, forces, symplectic Euler.
 // The model is described in ElasticSolid.h; the implicit integrator is in ElasticImplicit.cxx.
 #include "Elastic/ElasticSolid.h"
+#include "Common/Parallel.h"
 #include "Elastic/ElasticMath.h"
 
 #include <Eigen/Dense>
@@ -85,31 +86,36 @@ bool ElasticSolid::Initialize(
   {
     NeighborGrid grid;
     grid.Build(rest.data(), n);
-#pragma omp parallel if (this->N > kElasticParallel)
-    {
-      std::vector<Index> ids;
-      std::vector<double> d2;
-#pragma omp for schedule(static)
-      for (Index i = 0; i < n; ++i)
+    std::vector<std::vector<Index>> idsPerThread(MaxThreads());
+    std::vector<std::vector<double>> d2PerThread(MaxThreads());
+    ParallelFor(
+      n,
+      256,
+      [&](Index begin, Index end)
       {
-        const int found = grid.FindKNearest(&rest[3 * i], kWanted + 1, ids, d2);
-        if (found < 2)
+        std::vector<Index>& ids = idsPerThread[ThreadIndex()];
+        std::vector<double>& d2 = d2PerThread[ThreadIndex()];
+        for (Index i = begin; i < end; ++i)
         {
-          continue;
-        }
-        const double reach = std::sqrt(d2[std::min(found - 1, kWanted)]) * (1.0 + 1e-9);
-        grid.FindWithinRadiusSorted(&rest[3 * i], reach, ids, d2);
-        for (size_t t = 0; t < ids.size() && static_cast<int>(lists[i].size()) < 3 * kWanted; ++t)
-        {
-          if (ids[t] != i)
+          const int found = grid.FindKNearest(&rest[3 * i], kWanted + 1, ids, d2);
+          if (found < 2)
           {
-            lists[i].push_back(ids[t]);
-            lengths[i].push_back(std::sqrt(d2[t]));
+            continue;
           }
+          const double reach = std::sqrt(d2[std::min(found - 1, kWanted)]) * (1.0 + 1e-9);
+          grid.FindWithinRadiusSorted(&rest[3 * i], reach, ids, d2);
+          for (size_t t = 0; t < ids.size() && static_cast<int>(lists[i].size()) < 3 * kWanted; ++t)
+          {
+            if (ids[t] != i)
+            {
+              lists[i].push_back(ids[t]);
+              lengths[i].push_back(std::sqrt(d2[t]));
+            }
+          }
+          nearest[i] = lengths[i].empty() ? 0.0 : lengths[i][0];
         }
-        nearest[i] = lengths[i].empty() ? 0.0 : lengths[i][0];
-      }
-    }
+      },
+      kElasticParallel + 1);
   }
   int k = 1;
   for (const auto& l : lists)
@@ -130,136 +136,146 @@ bool ElasticSolid::Initialize(
   std::vector<double> weightSum(n, 0.0);
   Index illConditioned = 0;
 
-#pragma omp parallel for reduction(+ : illConditioned) schedule(static) if (this->N > kElasticParallel)
-  for (Index i = 0; i < n; ++i)
-  {
-    const int found = static_cast<int>(lists[i].size());
-    double sum = 0.0;
-    for (int t = 0; t < found; ++t)
+  illConditioned += ParallelReduce(
+    n,
+    1024,
+    decltype(illConditioned)(0),
+    [&](Index begin, Index end)
     {
-      this->Neighbor[i * k + t] = lists[i][t];
-      sum += lengths[i][t];
-    }
-    const double rbar = found > 0 ? sum / found : 0.0;
-    this->MeanDistance[i] = rbar;
-    if (!(rbar > 0.0))
-    {
-      // Isolated or fully coincident phyxel: no gradient information at all.
-      for (int a = 0; a < 3; ++a)
+      decltype(illConditioned) illConditioned = 0; // this block's part
+      for (Index i = begin; i < end; ++i)
       {
-        this->NullProjector[i * 9 + a * 4] = 1.0;
-      }
-      ++illConditioned;
-      continue;
-    }
-    const Kernel kernel(s.Kernel, 3, s.SupportScale * rbar);
-    const double invR = 1.0 / rbar;
-    this->InvRadius[i] = invR;
-    const int nb = this->Basis;
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero(); // linear moment matrix [4.12], scaled by 1/rbar
-    Eigen::Matrix<double, 9, 9> M = Eigen::Matrix<double, 9, 9>::Zero();
-    double wsum = 0.0;
-    for (int t = 0; t < found; ++t)
-    {
-      const Index j = this->Neighbor[i * k + t];
-      double X[3], q[3], p[9];
-      for (int a = 0; a < 3; ++a)
-      {
-        X[a] = rest[3 * j + a] - rest[3 * i + a];
-        this->RestOffset[(i * k + t) * 3 + a] = X[a];
-        q[a] = X[a] * invR;
-      }
-      const double w = kernel.Value(std::sqrt(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]));
-      this->Weight[i * k + t] = w;
-      wsum += w;
-      elastic::Basis(q, p);
-      const Eigen::Map<const Eigen::Vector3d> qv(q);
-      A += w * qv * qv.transpose();
-      if (nb == 9)
-      {
-        const Eigen::Map<const Eigen::Matrix<double, 9, 1>> pv(p);
-        M += w * pv * pv.transpose();
-      }
-    }
-    weightSum[i] = wsum;
-    // Linear part: symmetric eigen-decomposition (the SVD of this PSD matrix), pseudo-inverse, null space.
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(A);
-    const Eigen::Vector3d ev = eig.eigenvalues();
-    const double top = std::max(ev.cwiseAbs().maxCoeff(), 0.0);
-    Eigen::Matrix3d Ainv = Eigen::Matrix3d::Zero();
-    Eigen::Matrix3d Null = Eigen::Matrix3d::Zero();
-    bool singular = false;
-    for (int a = 0; a < 3; ++a)
-    {
-      const Eigen::Vector3d e = eig.eigenvectors().col(a);
-      if (top > 0.0 && ev[a] > 1e-6 * top)
-      {
-        Ainv += e * e.transpose() / ev[a];
-      }
-      else
-      {
-        Null += e * e.transpose();
-        singular = true;
-      }
-    }
-    illConditioned += singular ? 1 : 0;
-    // Quadratic fit when its moment matrix is well conditioned, else the linear one for this phyxel.
-    Eigen::Matrix<double, 9, 9> Minv = Eigen::Matrix<double, 9, 9>::Zero();
-    bool quadratic = false;
-    if (nb == 9 && !singular)
-    {
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eig9(M);
-      const double lo = eig9.eigenvalues().minCoeff(), hi = eig9.eigenvalues().maxCoeff();
-      if (hi > 0.0 && lo > 1e-6 * hi)
-      {
-        quadratic = true;
-        Minv = eig9.eigenvectors() * eig9.eigenvalues().cwiseInverse().asDiagonal() *
-          eig9.eigenvectors().transpose();
-      }
-    }
-    double dself[3] = { 0.0, 0.0, 0.0 };
-    for (int t = 0; t < found; ++t)
-    {
-      const double w = this->Weight[i * k + t];
-      double q[3], p[9];
-      for (int a = 0; a < 3; ++a)
-      {
-        q[a] = this->RestOffset[(i * k + t) * 3 + a] * invR;
-      }
-      elastic::Basis(q, p);
-      double* D = &this->Shape[(i * k + t) * nb];
-      if (quadratic)
-      {
-        const Eigen::Map<const Eigen::Matrix<double, 9, 1>> pv(p);
-        const Eigen::Matrix<double, 9, 1> d = Minv * pv * w;
-        for (int m = 0; m < 9; ++m)
+        const int found = static_cast<int>(lists[i].size());
+        double sum = 0.0;
+        for (int t = 0; t < found; ++t)
         {
-          D[m] = d[m];
+          this->Neighbor[i * k + t] = lists[i][t];
+          sum += lengths[i][t];
+        }
+        const double rbar = found > 0 ? sum / found : 0.0;
+        this->MeanDistance[i] = rbar;
+        if (!(rbar > 0.0))
+        {
+          // Isolated or fully coincident phyxel: no gradient information at all.
+          for (int a = 0; a < 3; ++a)
+          {
+            this->NullProjector[i * 9 + a * 4] = 1.0;
+          }
+          ++illConditioned;
+          continue;
+        }
+        const Kernel kernel(s.Kernel, 3, s.SupportScale * rbar);
+        const double invR = 1.0 / rbar;
+        this->InvRadius[i] = invR;
+        const int nb = this->Basis;
+        Eigen::Matrix3d A = Eigen::Matrix3d::Zero(); // linear moment matrix [4.12], scaled by 1/rbar
+        Eigen::Matrix<double, 9, 9> M = Eigen::Matrix<double, 9, 9>::Zero();
+        double wsum = 0.0;
+        for (int t = 0; t < found; ++t)
+        {
+          const Index j = this->Neighbor[i * k + t];
+          double X[3], q[3], p[9];
+          for (int a = 0; a < 3; ++a)
+          {
+            X[a] = rest[3 * j + a] - rest[3 * i + a];
+            this->RestOffset[(i * k + t) * 3 + a] = X[a];
+            q[a] = X[a] * invR;
+          }
+          const double w = kernel.Value(std::sqrt(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]));
+          this->Weight[i * k + t] = w;
+          wsum += w;
+          elastic::Basis(q, p);
+          const Eigen::Map<const Eigen::Vector3d> qv(q);
+          A += w * qv * qv.transpose();
+          if (nb == 9)
+          {
+            const Eigen::Map<const Eigen::Matrix<double, 9, 1>> pv(p);
+            M += w * pv * pv.transpose();
+          }
+        }
+        weightSum[i] = wsum;
+        // Linear part: symmetric eigen-decomposition (the SVD of this PSD matrix), pseudo-inverse, null space.
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(A);
+        const Eigen::Vector3d ev = eig.eigenvalues();
+        const double top = std::max(ev.cwiseAbs().maxCoeff(), 0.0);
+        Eigen::Matrix3d Ainv = Eigen::Matrix3d::Zero();
+        Eigen::Matrix3d Null = Eigen::Matrix3d::Zero();
+        bool singular = false;
+        for (int a = 0; a < 3; ++a)
+        {
+          const Eigen::Vector3d e = eig.eigenvectors().col(a);
+          if (top > 0.0 && ev[a] > 1e-6 * top)
+          {
+            Ainv += e * e.transpose() / ev[a];
+          }
+          else
+          {
+            Null += e * e.transpose();
+            singular = true;
+          }
+        }
+        illConditioned += singular ? 1 : 0;
+        // Quadratic fit when its moment matrix is well conditioned, else the linear one for this phyxel.
+        Eigen::Matrix<double, 9, 9> Minv = Eigen::Matrix<double, 9, 9>::Zero();
+        bool quadratic = false;
+        if (nb == 9 && !singular)
+        {
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eig9(M);
+          const double lo = eig9.eigenvalues().minCoeff(), hi = eig9.eigenvalues().maxCoeff();
+          if (hi > 0.0 && lo > 1e-6 * hi)
+          {
+            quadratic = true;
+            Minv =
+              eig9.eigenvectors() * eig9.eigenvalues().cwiseInverse().asDiagonal() * eig9.eigenvectors().transpose();
+          }
+        }
+        double dself[3] = { 0.0, 0.0, 0.0 };
+        for (int t = 0; t < found; ++t)
+        {
+          const double w = this->Weight[i * k + t];
+          double q[3], p[9];
+          for (int a = 0; a < 3; ++a)
+          {
+            q[a] = this->RestOffset[(i * k + t) * 3 + a] * invR;
+          }
+          elastic::Basis(q, p);
+          double* D = &this->Shape[(i * k + t) * nb];
+          if (quadratic)
+          {
+            const Eigen::Map<const Eigen::Matrix<double, 9, 1>> pv(p);
+            const Eigen::Matrix<double, 9, 1> d = Minv * pv * w;
+            for (int m = 0; m < 9; ++m)
+            {
+              D[m] = d[m];
+            }
+          }
+          else
+          {
+            const Eigen::Map<const Eigen::Vector3d> qv(q);
+            const Eigen::Vector3d d = Ainv * qv * w;
+            for (int m = 0; m < nb; ++m)
+            {
+              D[m] = m < 3 ? d[m] : 0.0;
+            }
+          }
+          for (int a = 0; a < 3; ++a)
+          {
+            dself[a] -= D[a] * invR; // d_ii = -sum_j d_ij, in physical units
+          }
+        }
+        for (int a = 0; a < 3; ++a)
+        {
+          this->SelfShape[i * 3 + a] = dself[a];
+          for (int b = 0; b < 3; ++b)
+          {
+            this->NullProjector[i * 9 + a * 3 + b] = Null(a, b);
+          }
         }
       }
-      else
-      {
-        const Eigen::Map<const Eigen::Vector3d> qv(q);
-        const Eigen::Vector3d d = Ainv * qv * w;
-        for (int m = 0; m < nb; ++m)
-        {
-          D[m] = m < 3 ? d[m] : 0.0;
-        }
-      }
-      for (int a = 0; a < 3; ++a)
-      {
-        dself[a] -= D[a] * invR; // d_ii = -sum_j d_ij, in physical units
-      }
-    }
-    for (int a = 0; a < 3; ++a)
-    {
-      this->SelfShape[i * 3 + a] = dself[a];
-      for (int b = 0; b < 3; ++b)
-      {
-        this->NullProjector[i * 9 + a * 3 + b] = Null(a, b);
-      }
-    }
-  }
+      return illConditioned;
+    },
+    [](decltype(illConditioned) a, decltype(illConditioned) b) { return a + b; },
+    kElasticParallel + 1);
   this->IllConditioned = illConditioned;
 
   // Masses m_i = s rbar_i^3 rho [4.15], s from the body's volume; volumes m_i / rho [4.22].

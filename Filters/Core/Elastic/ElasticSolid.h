@@ -58,7 +58,7 @@ namespace meshfree
 {
 
 /// Loops over fewer phyxels than this run on one thread: a parallel region costs more than the work, and far
-/// more on a loaded machine where OpenMP threads wait for a core.
+/// more on a loaded machine where the other threads wait for a core.
 constexpr Index kElasticParallel = 4096;
 
 enum class ElasticContainer

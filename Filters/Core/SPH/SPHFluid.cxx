@@ -2,18 +2,18 @@
 // SPHFluid.h). Part 1, the setup and initial state, is SPHSetup.cxx.
 #include "SPH/SPHFluid.h"
 
+#include "Common/Parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
-#include <omp.h>
-
 namespace meshfree
 {
 namespace
 {
-constexpr double StabilityLambda = 0.4; // largest CFL factor a fixed step may use before it is reduced
+constexpr double StabilityLambda = 0.4;   // largest CFL factor a fixed step may use before it is reduced
 constexpr double SurfaceThreshold = 0.25; // |grad c| h above which a particle is on the surface
 constexpr Index ParallelThreshold = 4096; // below: one thread (a fork-join would cost more than the work)
 }
@@ -35,36 +35,42 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
   // Wall dummies: a radius query per particle near a wall. The particles near a wall are not spread evenly
   // over the (Morton) order, so the work is handed out dynamically; each thread appends its rows to its own
   // buffer, and the rows are then copied into place in particle order (the lists do not depend on the schedule).
-  const int threads = omp_get_max_threads();
+  const int threads = MaxThreads();
   this->ThreadBoundary.resize(threads);
+  for (std::vector<std::int32_t>& wall : this->ThreadBoundary)
+  {
+    wall.clear();
+  }
+  std::vector<std::vector<Index>> threadIds(threads);
   this->BoundaryRowStart.resize(n);
   this->BoundaryRowThread.resize(n);
   Index* rowStart = this->BoundaryRowStart.data();
   std::int32_t* rowThread = this->BoundaryRowThread.data();
   Index* counts = this->BoundaryStart.data() + 1;
-#pragma omp parallel if (n >= ParallelThreshold)
-  {
-    const int t = omp_get_thread_num();
-    std::vector<std::int32_t>& wall = this->ThreadBoundary[t];
-    wall.clear();
-    std::vector<Index> ids;
-    ids.reserve(256);
-#pragma omp for schedule(dynamic, 512)
-    for (Index i = 0; i < n; ++i)
+  ParallelFor(
+    n,
+    512,
+    [&](Index begin, Index end)
     {
-      if (this->NearBoundary(x + 3 * i))
+      const int t = ThreadIndex();
+      std::vector<std::int32_t>& wall = this->ThreadBoundary[t];
+      std::vector<Index>& ids = threadIds[t];
+      for (Index i = begin; i < end; ++i)
       {
-        this->BoundaryGrid.FindWithinRadius(x + 3 * i, this->H, ids);
-        rowStart[i] = static_cast<Index>(wall.size());
-        rowThread[i] = t;
-        for (Index b : ids)
+        if (this->NearBoundary(x + 3 * i))
         {
-          wall.push_back(static_cast<std::int32_t>(b));
+          this->BoundaryGrid.FindWithinRadius(x + 3 * i, this->H, ids);
+          rowStart[i] = static_cast<Index>(wall.size());
+          rowThread[i] = t;
+          for (Index b : ids)
+          {
+            wall.push_back(static_cast<std::int32_t>(b));
+          }
+          counts[i] = static_cast<Index>(ids.size());
         }
-        counts[i] = static_cast<Index>(ids.size());
       }
-    }
-  }
+    },
+    ParallelThreshold);
   for (Index i = 0; i < n; ++i)
   {
     this->BoundaryStart[i + 1] += this->BoundaryStart[i];
@@ -72,15 +78,21 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
   this->BoundaryNeighbors.resize(this->BoundaryStart[n]);
   const Index* start = this->BoundaryStart.data();
   std::int32_t* rows = this->BoundaryNeighbors.data();
-#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
-  for (Index i = 0; i < n; ++i)
-  {
-    if (start[i + 1] > start[i])
+  ParallelFor(
+    n,
+    4096,
+    [&](Index begin, Index end)
     {
-      const std::int32_t* from = this->ThreadBoundary[rowThread[i]].data() + rowStart[i];
-      std::copy(from, from + (start[i + 1] - start[i]), rows + start[i]);
-    }
-  }
+      for (Index i = begin; i < end; ++i)
+      {
+        if (start[i + 1] > start[i])
+        {
+          const std::int32_t* from = this->ThreadBoundary[rowThread[i]].data() + rowStart[i];
+          std::copy(from, from + (start[i + 1] - start[i]), rows + start[i]);
+        }
+      }
+    },
+    ParallelThreshold);
 }
 
 void SPHFluid::ComputeAccelerations(SPHState& state)
@@ -113,36 +125,42 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   double* inverseDensity = this->InverseDensity.data();
 
   // Density (5.32) and pressure (5.40 / Tait).
-#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
-  for (Index i = 0; i < n; ++i)
-  {
-    const double* xi = x + 3 * i;
-    double fluidSum = this->DensityShape(0.0); // itself
-    for (Index s = fs[i]; s < fs[i + 1]; ++s)
+  ParallelFor(
+    n,
+    512,
+    [&](Index begin, Index end)
     {
-      const double* xj = x + 3 * fn[s];
-      const double dx = xi[0] - xj[0], dy = xi[1] - xj[1], dz = xi[2] - xj[2];
-      const double r2 = dx * dx + dy * dy + dz * dz;
-      if (r2 < h2)
+      for (Index i = begin; i < end; ++i)
       {
-        fluidSum += this->DensityShape(r2);
+        const double* xi = x + 3 * i;
+        double fluidSum = this->DensityShape(0.0); // itself
+        for (Index s = fs[i]; s < fs[i + 1]; ++s)
+        {
+          const double* xj = x + 3 * fn[s];
+          const double dx = xi[0] - xj[0], dy = xi[1] - xj[1], dz = xi[2] - xj[2];
+          const double r2 = dx * dx + dy * dy + dz * dz;
+          if (r2 < h2)
+          {
+            fluidSum += this->DensityShape(r2);
+          }
+        }
+        for (Index s = bs[i]; s < bs[i + 1]; ++s)
+        {
+          const double* xb = bx + 3 * bn[s];
+          const double dx = xi[0] - xb[0], dy = xi[1] - xb[1], dz = xi[2] - xb[2];
+          const double r2 = dx * dx + dy * dy + dz * dz;
+          if (r2 < h2)
+          {
+            fluidSum += this->DensityShape(r2); // dummies weigh like fluid particles
+          }
+        }
+        rho[i] = densityNorm * m * fluidSum;
+        pressure[i] = this->PressureOf(rho[i]);
+        pressureTerm[i] = pressure[i] / (rho[i] * rho[i]);
+        inverseDensity[i] = 1.0 / rho[i];
       }
-    }
-    for (Index s = bs[i]; s < bs[i + 1]; ++s)
-    {
-      const double* xb = bx + 3 * bn[s];
-      const double dx = xi[0] - xb[0], dy = xi[1] - xb[1], dz = xi[2] - xb[2];
-      const double r2 = dx * dx + dy * dy + dz * dz;
-      if (r2 < h2)
-      {
-        fluidSum += this->DensityShape(r2); // dummies weigh like fluid particles
-      }
-    }
-    rho[i] = densityNorm * m * fluidSum;
-    pressure[i] = this->PressureOf(rho[i]);
-    pressureTerm[i] = pressure[i] / (rho[i] * rho[i]);
-    inverseDensity[i] = 1.0 / rho[i];
-  }
+    },
+    ParallelThreshold);
 
   // Pressure of the dummies next to the fluid, extrapolated from their fluid neighbours with the hydrostatic
   // increase (Adami, Hu & Adams 2012, eq. 27 for static walls): p_b = (sum_f p_f W + g . sum_f rho_f (x_b - x_f) W)
@@ -154,44 +172,54 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
     this->BoundaryPressureTerm.assign(nb, 0.0);
     this->BoundaryActive.assign(nb, 0);
     const Index total = bs[n];
-#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
-    for (Index s = 0; s < total; ++s)
-    {
-      this->BoundaryActive[bn[s]] = 1; // same value from every thread
-    }
+    ParallelFor(
+      total,
+      1024,
+      [&](Index begin, Index end)
+      {
+        for (Index s = begin; s < end; ++s)
+        {
+          this->BoundaryActive[bn[s]] = 1; // same value from every thread
+        }
+      },
+      ParallelThreshold);
     double* pbTerm = this->BoundaryPressureTerm.data();
     const char* active = this->BoundaryActive.data();
-#pragma omp parallel if (n >= ParallelThreshold)
-    {
-      std::vector<Index> ids;
-#pragma omp for schedule(dynamic, 256)
-      for (Index b = 0; b < nb; ++b)
+    std::vector<std::vector<Index>> threadIds(MaxThreads());
+    ParallelFor(
+      nb,
+      256,
+      [&](Index begin, Index end)
       {
-        if (!active[b])
+        std::vector<Index>& ids = threadIds[ThreadIndex()];
+        for (Index b = begin; b < end; ++b)
         {
-          continue;
-        }
-        const double* xb = bx + 3 * b;
-        this->Grid.FindWithinRadius(xb, h, ids);
-        double sumW = 0.0, sumP = 0.0, sumG = 0.0;
-        for (Index f : ids)
-        {
-          const double* xf = x + 3 * f;
-          const double r[3] = { xb[0] - xf[0], xb[1] - xf[1], xb[2] - xf[2] };
-          const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-          if (r2 < h2)
+          if (!active[b])
           {
-            const double w = this->DensityShape(r2);
-            sumW += w;
-            sumP += pressure[f] * w;
-            sumG += rho[f] * (g[0] * r[0] + g[1] * r[1] + g[2] * r[2]) * w;
+            continue;
           }
+          const double* xb = bx + 3 * b;
+          this->Grid.FindWithinRadius(xb, h, ids);
+          double sumW = 0.0, sumP = 0.0, sumG = 0.0;
+          for (Index f : ids)
+          {
+            const double* xf = x + 3 * f;
+            const double r[3] = { xb[0] - xf[0], xb[1] - xf[1], xb[2] - xf[2] };
+            const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            if (r2 < h2)
+            {
+              const double w = this->DensityShape(r2);
+              sumW += w;
+              sumP += pressure[f] * w;
+              sumG += rho[f] * (g[0] * r[0] + g[1] * r[1] + g[2] * r[2]) * w;
+            }
+          }
+          const double pb = sumW > 0.0 ? std::max(0.0, (sumP + sumG) / sumW) : 0.0;
+          const double rhoB = this->DensityOf(pb);
+          pbTerm[b] = pb / (rhoB * rhoB); // the pair force's p_b / rho_b^2, once per dummy
         }
-        const double pb = sumW > 0.0 ? std::max(0.0, (sumP + sumG) / sumW) : 0.0;
-        const double rhoB = this->DensityOf(pb);
-        pbTerm[b] = pb / (rhoB * rhoB); // the pair force's p_b / rho_b^2, once per dummy
-      }
-    }
+      },
+      n >= ParallelThreshold ? 0 : nb + 1);
   }
   const double* pbTerm = this->BoundaryPressureTerm.data();
 
@@ -205,110 +233,117 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   const double avFactor = p.ArtificialViscosity * this->C0 * hs, avEps = 0.01 * hs * hs;
   const bool artificial = avFactor > 0.0;
   const double pressureFactor = m * gradientNorm, viscousFactor = mu * m * visc;
-#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
-  for (Index i = 0; i < n; ++i)
-  {
-    const double* xi = x + 3 * i;
-    const double* vi = v + 3 * i;
-    const double rhoI = rho[i], inverseI = inverseDensity[i];
-    const double termI = pressureTerm[i];
-    double ap[3] = { 0.0, 0.0, 0.0 }, av[3] = { 0.0, 0.0, 0.0 }, normal[3] = { 0.0, 0.0, 0.0 };
-    double colourLaplacian = 0.0;
-    // Colour field c = sum_j V_j W_poly6: grad W = gradient r, lap W = -6 poly6 q (d q - 4 r^2), q = h^2 - r^2.
-    auto addColour = [&](double volume, const double r[3], double r2) {
-      const double q = h2 - r2;
-      const double gradient = -6.0 * poly6 * q * q;
-      normal[0] += volume * gradient * r[0];
-      normal[1] += volume * gradient * r[1];
-      normal[2] += volume * gradient * r[2];
-      colourLaplacian += volume * -6.0 * poly6 * q * (d * q - 4.0 * r2);
-    };
-    for (Index s = fs[i]; s < fs[i + 1]; ++s)
+  ParallelFor(
+    n,
+    256,
+    [&](Index begin, Index end)
     {
-      const Index j = fn[s];
-      const double* xj = x + 3 * j;
-      const double r[3] = { xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2] };
-      const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-      if (!(r2 < h2))
+      for (Index i = begin; i < end; ++i)
       {
-        continue;
-      }
-      const double dist = std::sqrt(r2);
-      if (dist > 0.0)
-      {
-        // -m (p_i/rho_i^2 + p_j/rho_j^2) grad W, grad W = -gradientNorm shape(r) r
-        double pair = termI + pressureTerm[j];
-        if (artificial)
+        const double* xi = x + 3 * i;
+        const double* vi = v + 3 * i;
+        const double rhoI = rho[i], inverseI = inverseDensity[i];
+        const double termI = pressureTerm[i];
+        double ap[3] = { 0.0, 0.0, 0.0 }, av[3] = { 0.0, 0.0, 0.0 }, normal[3] = { 0.0, 0.0, 0.0 };
+        double colourLaplacian = 0.0;
+        // Colour field c = sum_j V_j W_poly6: grad W = gradient r, lap W = -6 poly6 q (d q - 4 r^2), q = h^2 - r^2.
+        auto addColour = [&](double volume, const double r[3], double r2)
         {
-          const double* vj = v + 3 * j;
-          const double vr = (vi[0] - vj[0]) * r[0] + (vi[1] - vj[1]) * r[1] + (vi[2] - vj[2]) * r[2];
-          pair += vr < 0.0 ? -avFactor * vr / (0.5 * (rhoI + rho[j]) * (r2 + avEps)) : 0.0;
+          const double q = h2 - r2;
+          const double gradient = -6.0 * poly6 * q * q;
+          normal[0] += volume * gradient * r[0];
+          normal[1] += volume * gradient * r[1];
+          normal[2] += volume * gradient * r[2];
+          colourLaplacian += volume * -6.0 * poly6 * q * (d * q - 4.0 * r2);
+        };
+        for (Index s = fs[i]; s < fs[i + 1]; ++s)
+        {
+          const Index j = fn[s];
+          const double* xj = x + 3 * j;
+          const double r[3] = { xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2] };
+          const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+          if (!(r2 < h2))
+          {
+            continue;
+          }
+          const double dist = std::sqrt(r2);
+          if (dist > 0.0)
+          {
+            // -m (p_i/rho_i^2 + p_j/rho_j^2) grad W, grad W = -gradientNorm shape(r) r
+            double pair = termI + pressureTerm[j];
+            if (artificial)
+            {
+              const double* vj = v + 3 * j;
+              const double vr = (vi[0] - vj[0]) * r[0] + (vi[1] - vj[1]) * r[1] + (vi[2] - vj[2]) * r[2];
+              pair += vr < 0.0 ? -avFactor * vr / (0.5 * (rhoI + rho[j]) * (r2 + avEps)) : 0.0;
+            }
+            const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
+            ap[0] += coefficient * r[0];
+            ap[1] += coefficient * r[1];
+            ap[2] += coefficient * r[2];
+          }
+          if (viscous)
+          {
+            const double coefficient = viscousFactor * (h - dist) * inverseI * inverseDensity[j];
+            const double* vj = v + 3 * j;
+            av[0] += coefficient * (vj[0] - vi[0]);
+            av[1] += coefficient * (vj[1] - vi[1]);
+            av[2] += coefficient * (vj[2] - vi[2]);
+          }
+          if (tension)
+          {
+            addColour(m * inverseDensity[j], r, r2);
+          }
         }
-        const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
-        ap[0] += coefficient * r[0];
-        ap[1] += coefficient * r[1];
-        ap[2] += coefficient * r[2];
+        for (Index s = bs[i]; s < bs[i + 1]; ++s)
+        {
+          const Index b = bn[s];
+          const double* xb = bx + 3 * b;
+          const double r[3] = { xi[0] - xb[0], xi[1] - xb[1], xi[2] - xb[2] };
+          const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+          if (!(r2 < h2))
+          {
+            continue;
+          }
+          const double dist = std::sqrt(r2);
+          if (dist > 0.0)
+          {
+            // Symmetric pair force with the dummy's extrapolated pressure (its density from the EOS).
+            // No artificial viscosity against the wall: with a particle sliding along it, the dummies ahead are
+            // approached and those behind are not, so the term would act as wall friction (free slip wanted).
+            const double pair = termI + pbTerm[b];
+            const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
+            ap[0] += coefficient * r[0];
+            ap[1] += coefficient * r[1];
+            ap[2] += coefficient * r[2];
+          }
+          if (tension)
+          {
+            addColour(m / p.RestDensity, r, r2); // walls count as fluid (neutral wetting): no surface along them
+          }
+        }
+        double* ai = acc + 3 * i;
+        ai[0] = ap[0] + av[0] + g[0];
+        ai[1] = ap[1] + av[1] + g[1];
+        ai[2] = ap[2] + av[2] + g[2];
+        if (tension)
+        {
+          const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+          if (length * h > SurfaceThreshold)
+          {
+            const double factor = -sigma * colourLaplacian * inverseI / length;
+            ai[0] += factor * normal[0];
+            ai[1] += factor * normal[1];
+            ai[2] += factor * normal[2];
+          }
+        }
+        if (d == 2)
+        {
+          ai[1] = 0.0;
+        }
       }
-      if (viscous)
-      {
-        const double coefficient = viscousFactor * (h - dist) * inverseI * inverseDensity[j];
-        const double* vj = v + 3 * j;
-        av[0] += coefficient * (vj[0] - vi[0]);
-        av[1] += coefficient * (vj[1] - vi[1]);
-        av[2] += coefficient * (vj[2] - vi[2]);
-      }
-      if (tension)
-      {
-        addColour(m * inverseDensity[j], r, r2);
-      }
-    }
-    for (Index s = bs[i]; s < bs[i + 1]; ++s)
-    {
-      const Index b = bn[s];
-      const double* xb = bx + 3 * b;
-      const double r[3] = { xi[0] - xb[0], xi[1] - xb[1], xi[2] - xb[2] };
-      const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-      if (!(r2 < h2))
-      {
-        continue;
-      }
-      const double dist = std::sqrt(r2);
-      if (dist > 0.0)
-      {
-        // Symmetric pair force with the dummy's extrapolated pressure (its density from the EOS).
-        // No artificial viscosity against the wall: with a particle sliding along it, the dummies ahead are
-        // approached and those behind are not, so the term would act as wall friction (free slip wanted).
-        const double pair = termI + pbTerm[b];
-        const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
-        ap[0] += coefficient * r[0];
-        ap[1] += coefficient * r[1];
-        ap[2] += coefficient * r[2];
-      }
-      if (tension)
-      {
-        addColour(m / p.RestDensity, r, r2); // walls count as fluid (neutral wetting): no surface along them
-      }
-    }
-    double* ai = acc + 3 * i;
-    ai[0] = ap[0] + av[0] + g[0];
-    ai[1] = ap[1] + av[1] + g[1];
-    ai[2] = ap[2] + av[2] + g[2];
-    if (tension)
-    {
-      const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-      if (length * h > SurfaceThreshold)
-      {
-        const double factor = -sigma * colourLaplacian * inverseI / length;
-        ai[0] += factor * normal[0];
-        ai[1] += factor * normal[1];
-        ai[2] += factor * normal[2];
-      }
-    }
-    if (d == 2)
-    {
-      ai[1] = 0.0;
-    }
-  }
+    },
+    ParallelThreshold);
 }
 
 void SPHFluid::Enforce(SPHState& state, Index begin, Index end) const
@@ -371,15 +406,22 @@ void SPHFluid::Reorder(SPHState& state)
   {
     return;
   }
-  auto permute3 = [&](std::vector<double>& a) {
+  auto permute3 = [&](std::vector<double>& a)
+  {
     std::vector<double> b(a.size());
-#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
-    for (Index s = 0; s < n; ++s)
-    {
-      b[3 * s] = a[3 * order[s]];
-      b[3 * s + 1] = a[3 * order[s] + 1];
-      b[3 * s + 2] = a[3 * order[s] + 2];
-    }
+    ParallelFor(
+      n,
+      8192,
+      [&](Index begin, Index end)
+      {
+        for (Index s = begin; s < end; ++s)
+        {
+          b[3 * s] = a[3 * order[s]];
+          b[3 * s + 1] = a[3 * order[s] + 1];
+          b[3 * s + 2] = a[3 * order[s] + 2];
+        }
+      },
+      ParallelThreshold);
     a.swap(b);
   };
   permute3(state.Position);
@@ -397,20 +439,44 @@ void SPHFluid::Reorder(SPHState& state)
 double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
 {
   const Index n = state.Size();
-  double v2max = 0.0, a2max = 0.0, rhoMax = this->Params.RestDensity;
-  bool finite = true;
-#pragma omp parallel for if (n >= ParallelThreshold) schedule(static) reduction(max : v2max, a2max, rhoMax) reduction(&& : finite)
-  for (Index i = 0; i < n; ++i)
+  struct Extremes
   {
-    const double* v = &state.Velocity[3 * i];
-    const double* a = &state.Acceleration[3 * i];
-    const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-    const double a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    finite = finite && std::isfinite(v2) && std::isfinite(a2) && std::isfinite(state.Density[i]);
-    v2max = std::max(v2max, v2);
-    a2max = std::max(a2max, a2);
-    rhoMax = std::max(rhoMax, state.Density[i]);
-  }
+    double V2 = 0.0, A2 = 0.0, Rho = 0.0;
+    bool Finite = true;
+  };
+  Extremes identity;
+  identity.Rho = this->Params.RestDensity;
+  const Extremes e = ParallelReduce(
+    n,
+    4096,
+    identity,
+    [&](Index begin, Index end)
+    {
+      Extremes m = identity;
+      for (Index i = begin; i < end; ++i)
+      {
+        const double* v = &state.Velocity[3 * i];
+        const double* a = &state.Acceleration[3 * i];
+        const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        const double a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        m.Finite = m.Finite && std::isfinite(v2) && std::isfinite(a2) && std::isfinite(state.Density[i]);
+        m.V2 = std::max(m.V2, v2);
+        m.A2 = std::max(m.A2, a2);
+        m.Rho = std::max(m.Rho, state.Density[i]);
+      }
+      return m;
+    },
+    [](Extremes x, const Extremes& y)
+    {
+      x.V2 = std::max(x.V2, y.V2);
+      x.A2 = std::max(x.A2, y.A2);
+      x.Rho = std::max(x.Rho, y.Rho);
+      x.Finite = x.Finite && y.Finite;
+      return x;
+    },
+    ParallelThreshold);
+  const double v2max = e.V2, a2max = e.A2, rhoMax = e.Rho;
+  const bool finite = e.Finite;
   if (!finite)
   {
     return std::numeric_limits<double>::quiet_NaN();
@@ -498,34 +564,42 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
 
     // Kick - drift (with the wall and obstacle projection).
     const double half = 0.5 * dt;
-#pragma omp parallel if (n >= ParallelThreshold)
-    {
-      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-      const Index begin = n * t / threads, end = n * (t + 1) / threads;
-      for (Index i = begin; i < end; ++i)
+    ParallelFor(
+      n,
+      2048,
+      [&](Index begin, Index end)
       {
-        double* x = &state.Position[3 * i];
-        double* v = &state.Velocity[3 * i];
-        const double* a = &state.Acceleration[3 * i];
-        for (int c = 0; c < 3; ++c)
+        for (Index i = begin; i < end; ++i)
         {
-          v[c] += half * a[c];
-          x[c] += dt * v[c];
+          double* x = &state.Position[3 * i];
+          double* v = &state.Velocity[3 * i];
+          const double* a = &state.Acceleration[3 * i];
+          for (int c = 0; c < 3; ++c)
+          {
+            v[c] += half * a[c];
+            x[c] += dt * v[c];
+          }
         }
-      }
-      this->Enforce(state, begin, end);
-    }
+        this->Enforce(state, begin, end);
+      },
+      ParallelThreshold);
     if (state.Steps % p.ReorderInterval == 0)
     {
       this->Reorder(state);
     }
     this->ComputeAccelerations(state);
     // Kick.
-#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
-    for (Index i = 0; i < 3 * n; ++i)
-    {
-      state.Velocity[i] += half * state.Acceleration[i];
-    }
+    ParallelFor(
+      3 * n,
+      16384,
+      [&](Index begin, Index end)
+      {
+        for (Index i = begin; i < end; ++i)
+        {
+          state.Velocity[i] += half * state.Acceleration[i];
+        }
+      },
+      ParallelThreshold);
     state.Time = last ? targetTime : state.Time + dt;
     ++state.Steps;
     ++steps;
@@ -546,21 +620,29 @@ std::vector<int> SPHFluid::NeighborCounts(const SPHState& state)
     return counts;
   }
   this->Grid.Build(state.Position.data(), n, this->H);
-#pragma omp parallel for if (n >= ParallelThreshold) schedule(static)
-  for (Index i = 0; i < n; ++i)
-  {
-    // Strictly inside the support, as the sums count them.
-    Index c = 0;
-    const double* xi = &state.Position[3 * i];
-    std::vector<Index> ids;
-    std::vector<double> d2;
-    this->Grid.FindWithinRadius(xi, this->H, ids, &d2);
-    for (std::size_t k = 0; k < ids.size(); ++k)
+  std::vector<std::vector<Index>> threadIds(MaxThreads());
+  std::vector<std::vector<double>> threadDistances(MaxThreads());
+  ParallelFor(
+    n,
+    256,
+    [&](Index begin, Index end)
     {
-      c += (ids[k] != i && d2[k] < this->H2) ? 1 : 0;
-    }
-    counts[i] = static_cast<int>(c);
-  }
+      std::vector<Index>& ids = threadIds[ThreadIndex()];
+      std::vector<double>& d2 = threadDistances[ThreadIndex()];
+      for (Index i = begin; i < end; ++i)
+      {
+        // Strictly inside the support, as the sums count them.
+        Index c = 0;
+        const double* xi = &state.Position[3 * i];
+        this->Grid.FindWithinRadius(xi, this->H, ids, &d2);
+        for (std::size_t k = 0; k < ids.size(); ++k)
+        {
+          c += (ids[k] != i && d2[k] < this->H2) ? 1 : 0;
+        }
+        counts[i] = static_cast<int>(c);
+      }
+    },
+    ParallelThreshold);
   return counts;
 }
 
@@ -583,8 +665,8 @@ SPHStatistics SPHFluid::Statistics(const SPHState& state, double mass)
     s.MinDensity = std::min(s.MinDensity, state.Density[i]);
     s.MaxDensity = std::max(s.MaxDensity, state.Density[i]);
     s.Finite = s.Finite && std::isfinite(v2) && std::isfinite(state.Position[3 * i]) &&
-      std::isfinite(state.Position[3 * i + 1]) && std::isfinite(state.Position[3 * i + 2]) &&
-      std::isfinite(state.Density[i]) && std::isfinite(state.Pressure[i]);
+               std::isfinite(state.Position[3 * i + 1]) && std::isfinite(state.Position[3 * i + 2]) &&
+               std::isfinite(state.Density[i]) && std::isfinite(state.Pressure[i]);
   }
   return s;
 }
