@@ -80,6 +80,17 @@ vtkSmartPointer<vtkDoubleArray> MakeArray(const char* name, int components, vtkI
 }
 } // namespace
 
+void vtkMeshFreeDeformableSolid::ReportInputWithoutPort(vtkObject* surface)
+{
+  if (surface)
+  {
+    vtkErrorMacro("MLS Deformable Solid (pvpython MLSDeformableSolid) is a pure source and takes no input: this Input "
+                  "is ignored and the built-in Shape is used. To fill a closed surface use MLS Deformable Solid From "
+                  "Surface: MLSDeformableSolidFromSurface(Input=surface, ...) in pvpython, Filters > MeshFree in "
+                  "the GUI.");
+  }
+}
+
 int vtkMeshFreeDeformableSolid::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {

@@ -4,11 +4,13 @@
  *          (Mueller et al. 2004, "Point based animation of elastic, plastic and melting objects"; thesis ch. 4)
  *
  * Phyxels fill a built-in `Shape` inscribed in `ShapeBounds`, or the inside of the closed surface on the
- * optional input, on a cubic lattice of `PhyxelSpacing`. Their displacement gradient is an MLS fit over their
+ * optional input, on a cubic lattice of `PhyxelSpacing`. ParaView offers the two uses as two proxies, as it does
+ * for its Stream Tracer: the pure source `MLSDeformableSolid` (no input property, so nothing is ever connected to
+ * it behind the user's back) and `MLSDeformableSolidFromSurface`, whose required input is the surface. Their displacement gradient is an MLS fit over their
  * neighbours, strain is Green-Saint-Venant, stress Hooke's law with the physical `YoungModulus` and
  * `PoissonRatio`, and the forces conserve linear and angular momentum. Gravity, velocity damping, a box or
  * cylinder container, pinned phyxels (`FixedBounds`), Lennard-Jones self-contact, hourglass control and
- * plasticity are included. Integrators: symplectic Euler (automatic stable step; a larger TimeStep is
+ * plasticity are included. There is no container unless `Container` asks for one. Integrators: symplectic Euler (automatic stable step; a larger TimeStep is
  * sub-stepped with a warning) or linearised backward Euler solved by conjugate gradients. All numerics are in
  * the VTK-free core, meshfree::ElasticSolid (Filters/Core/ElasticSolid.h), which documents the model.
  *
@@ -124,7 +126,8 @@ public:
   ///@}
 
   ///@{
-  /** Collisions: container, its bounds, restitution and friction; Lennard-Jones self-contact; pinned box. */
+  /** Collisions: container (default NO_CONTAINER: no walls, whatever the body's bounds), its bounds (used only
+   *  with a container), restitution and friction; Lennard-Jones self-contact; pinned box. */
   vtkSetClampMacro(Container, int, NO_CONTAINER, CYLINDER_CONTAINER);
   vtkGetMacro(Container, int);
   vtkSetVector6Macro(ContainerBounds, double);
@@ -160,6 +163,14 @@ public:
   vtkGetMacro(ConjugateGradientIterations, int);
   ///@}
 
+  /**
+   * Called by the hidden `Input` property of ParaView's pure source `MLSDeformableSolid`, left for scripts written
+   * when that proxy had an input: reports, as an error, that a surface to fill is the input of
+   * `MLSDeformableSolidFromSurface`. The argument is not connected (connect the surface to input port 0).
+   * Nothing happens for nullptr.
+   */
+  void ReportInputWithoutPort(vtkObject* surface);
+
 protected:
   vtkMeshFreeDeformableSolid();
   ~vtkMeshFreeDeformableSolid() override;
@@ -189,7 +200,7 @@ protected:
   double Damping = 0.0;
   double Gravity[3] = { 0.0, 0.0, -9.81 };
   double InitialVelocity[3] = { 0.0, 0.0, 0.0 };
-  int Container = BOX_CONTAINER;
+  int Container = NO_CONTAINER;
   double ContainerBounds[6] = { -0.5, 0.5, -0.5, 0.5, 0.0, 1.0 };
   double Restitution = 0.3;
   double Friction = 0.3;

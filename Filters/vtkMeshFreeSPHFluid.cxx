@@ -114,6 +114,16 @@ int vtkMeshFreeSPHFluid::GetNumberOfOutputTimes()
   return static_cast<int>(meshfree::OutputTimes(this->EndTime, this->OutputInterval).size());
 }
 
+void vtkMeshFreeSPHFluid::ReportObstaclesWithoutPort(vtkObject* obstacles)
+{
+  if (obstacles)
+  {
+    vtkErrorMacro("SPH Fluid (pvpython SPHFluid) is a pure source and takes no input: these Obstacles are ignored and "
+                  "the fluid runs without them. For obstacles use SPH Fluid With Obstacles: "
+                  "SPHFluidWithObstacles(Obstacles=surface, ...) in pvpython, Filters > MeshFree in the GUI.");
+  }
+}
+
 int vtkMeshFreeSPHFluid::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {

@@ -15,7 +15,9 @@
  * a property that affects the simulation, or of the `Obstacles` input, empties the cache.
  *
  * Optional input port 0, `Obstacles`: closed polygonal surfaces (polygons and triangle strips are triangulated)
- * that the fluid flows around.
+ * that the fluid flows around. ParaView offers the two uses as two proxies, as it does for its Stream Tracer: the
+ * pure source `SPHFluid` (no input property, so nothing is ever connected to it behind the user's back) and
+ * `SPHFluidWithObstacles`, whose required input is this port.
  *
  * Output: vtkPolyData, one vertex per particle, point arrays `Velocity` (3), `Density`, `Pressure`, `Id`
  * (stable across time), and on request `Acceleration` (3) and `NeighborCount`.
@@ -162,6 +164,13 @@ public:
 
   /** The output times reported by RequestInformation (for tests). */
   int GetNumberOfOutputTimes();
+
+  /**
+   * Called by the hidden `Obstacles` property of ParaView's pure source `SPHFluid`, left for scripts written when
+   * that proxy had an input: reports, as an error, that obstacles are the input of `SPHFluidWithObstacles`. The
+   * argument is not connected (connect obstacles to input port 0). Nothing happens for nullptr.
+   */
+  void ReportObstaclesWithoutPort(vtkObject* obstacles);
 
 protected:
   vtkMeshFreeSPHFluid();

@@ -45,7 +45,6 @@ def _container(kind, view):
 
 
 def _render_scene(scene, out):
-    simple.SetActiveSource(None)  # no active source: the built-in shape, not an Input
     properties = {k: v for k, v in scene.items() if k not in ("name", "title", "surface")}
     solid = MLSDeformableSolid(ContainerBounds=CONTAINER, InitialVelocity=[0.6, 0.3, 0.0], Damping=1.0,
                                EndTime=2.0, OutputInterval=0.05, **properties)

@@ -25,8 +25,7 @@ def phyxels(data):
 
 
 def make(**kw):
-    # paraview.simple connects the active source as Input: none is active, so the built-in shape is used.
-    simple.SetActiveSource(None)
+    # A pure source: whatever is active, the built-in shape is used (test_source_inputs.py checks that).
     settings = dict(EndTime=0.6, OutputInterval=0.05, PhyxelSpacing=0.05)
     settings.update(kw)
     return MLSDeformableSolid(**settings)
@@ -107,7 +106,7 @@ p = phyxels(data)
 assert np.all(np.asarray(p.PointData["Displacement"]) == 0)
 assert np.allclose(np.asarray(p.PointData["Velocity"]), [0.5, 0, 0])
 
-# Every container keeps the phyxels inside; a closed surface as Input is filled and embedded.
+# Every container keeps the phyxels inside; a closed surface as the variant's Input is filled and embedded.
 for container in ("Box", "Cylinder"):
     box = make(Container=container, ContainerBounds=[-0.3, 0.3, -0.3, 0.3, 0.0, 1.0], InitialVelocity=[2, 1, 0])
     x = np.array(phyxels(state(box, 0.6)[0]).Points)
@@ -118,7 +117,7 @@ for container in ("Box", "Cylinder"):
         assert np.all(np.hypot(x[:, 0], x[:, 1]) <= 0.3 + 1e-12) and np.all(x[:, 2] >= 0)
 
 sphere = simple.Sphere(Radius=0.2, Center=[0, 0, 0.5], ThetaResolution=24, PhiResolution=24)
-filled = MLSDeformableSolid(Input=sphere, EndTime=0.1, OutputInterval=0.05, PhyxelSpacing=0.05)
+filled = MLSDeformableSolidFromSurface(Input=sphere, EndTime=0.1, OutputInterval=0.05, PhyxelSpacing=0.05)
 data, steps = state(filled, 0.1)
 p = phyxels(data)
 rest = np.array(p.Points) - np.asarray(p.PointData["Displacement"])

@@ -30,17 +30,13 @@ CAMERA = ([0, -11, 3.5], [0, 0, 0.8], [0, 0, 1])
 def solid(figure):
     if figure == "4.8":
         surface = simple.OpenDataFile(fc.data("ellipsoid_715_surface.ply"))
-        s = MLSDeformableSolid(Input=surface)  # noqa: F821
+        s = MLSDeformableSolidFromSurface(Input=surface)  # noqa: F821
         s.PhyxelSpacing = 0.13
         s.Container = "Cylinder"
         s.ContainerBounds = [-1.6, 1.6, -1.6, 1.6, -1.2, 3.0]
         s.YoungModulus, s.PoissonRatio, s.Density, s.WeightFunction = 100.0, 0.2, 5.0, "Poly6"
     else:
-        # paraview.simple connects the active source (here the previous figure's last filter) to a new
-        # filter's Input unless told otherwise: that made the solid read a point cloud without polygons as
-        # its surface ("The input must be a closed surface") when the figures ran one after the other.
-        simple.SetActiveSource(None)
-        s = MLSDeformableSolid()  # noqa: F821
+        s = MLSDeformableSolid()  # noqa: F821  (a pure source: it never takes the active source)
         if figure == "4.6":
             s.Shape = "Octahedron"
             s.ShapeBounds = [-1, 1, -1, 1, 0.5, 2.51]
