@@ -123,7 +123,7 @@ void ParallelRanges(Index n, Index grain, RangeFunction fn, void* body)
         fn(body, r.begin(), r.end());
         --NestingDepth;
       },
-      tbb::auto_partitioner());
+      tbb::simple_partitioner()); // ranges of at most `grain` items (see Parallel.h)
   });
 }
 } // namespace detail

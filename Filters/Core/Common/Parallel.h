@@ -38,12 +38,14 @@ const char* ParallelBackend();
 namespace detail
 {
 using RangeFunction = void (*)(void* body, Index begin, Index end);
-/// Runs fn(body, b, e) over ranges [b, e) covering [0, n), each of about grain items or more.
+/// Runs fn(body, b, e) over ranges [b, e) covering [0, n), each of at most grain items.
 void ParallelRanges(Index n, Index grain, RangeFunction fn, void* body);
 } // namespace detail
 
 /// Calls body(begin, end) for ranges covering [0, n) exactly once, in parallel when n >= serialBelow and
-/// more than one thread is allowed. grain: the smallest range worth handing to another thread.
+/// more than one thread is allowed. Ranges hold at most `grain` items (at least about half as many): small
+/// enough that a thread the OS deschedules holds back little work (the others finish the rest; the loop
+/// waits only for the range in hand), large enough to pay for handing a range out (about a microsecond).
 template <class Body>
 void ParallelFor(Index n, Index grain, Body&& body, Index serialBelow = 0)
 {
