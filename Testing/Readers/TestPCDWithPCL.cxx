@@ -6,6 +6,8 @@
 #include "vtkMeshFreePCDReader.h"
 #include "vtkMeshFreePCDWriter.h"
 
+#include "ReaderTestSupport.h"
+
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
@@ -28,6 +30,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+using namespace meshfree_test;
 
 namespace
 {
@@ -55,34 +59,22 @@ std::string Path(const std::string& name)
   return ::testing::AssertionFailure() << command << " failed (" << rc << "):\n" << text.str();
 }
 
-std::string ReadBytes(const std::string& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class MessageCatcher : public vtkCommand
-{
-public:
-  static MessageCatcher* New() { return new MessageCatcher; }
-  void Execute(vtkObject*, unsigned long event, void* data) override
-  {
-    (event == vtkCommand::ErrorEvent ? this->Errors : this->Warnings) += static_cast<const char*>(data);
-  }
-  std::string Errors, Warnings;
-};
-
 vtkSmartPointer<vtkPolyData> Read(const std::string& name, MessageCatcher* msg, bool keepInvalid = false)
 {
-  vtkNew<vtkMeshFreePCDReader> reader;
-  reader->SetFileName(Path(name).c_str());
-  reader->SetKeepInvalidPoints(keepInvalid);
-  reader->AddObserver(vtkCommand::ErrorEvent, msg);
-  reader->AddObserver(vtkCommand::WarningEvent, msg);
-  reader->Update();
-  return reader->GetOutput();
+  return meshfree_test::Read<vtkMeshFreePCDReader>(Path(name), msg, keepInvalid);
+}
+
+// The smallest |n . p| over a cloud with Normals: 1 where every normal is radial (clouds on the unit sphere).
+double MinRadialAlignment(vtkPolyData* cloud)
+{
+  double worst = 1;
+  for (vtkIdType i = 0; i < cloud->GetNumberOfPoints(); ++i)
+  {
+    const double* p = cloud->GetPoint(i);
+    const double* n = cloud->GetPointData()->GetNormals()->GetTuple3(i);
+    worst = std::min(worst, std::abs(p[0] * n[0] + p[1] * n[1] + p[2] * n[2]));
+  }
+  return worst;
 }
 
 // The vertices of an ascii PLY file (as pcl_converter writes it): one row of values per vertex.
@@ -139,9 +131,9 @@ std::string AsciiPCD(const std::string& fields, const std::string& sizes, const 
   return text;
 }
 
-void WriteText(const std::string& name, const std::string& text)
+void WriteFixture(const std::string& name, const std::string& text)
 {
-  std::ofstream(Path(name), std::ios::binary) << text;
+  meshfree_test::WriteText(Path(name), text);
 }
 
 // Bytes of the data section after POINTS records of `recordBytes` (PCL's page padding in a binary file).
@@ -175,7 +167,7 @@ std::vector<std::vector<float>> Sphere(int n)
 std::vector<std::vector<float>> SphereFile()
 {
   const auto rows = Sphere(1000);
-  WriteText("sphere.pcd", AsciiPCD("x y z", "4 4 4", "F F F", 1000, 1, rows));
+  WriteFixture("sphere.pcd", AsciiPCD("x y z", "4 4 4", "F F F", 1000, 1, rows));
   return rows;
 }
 } // namespace
@@ -219,7 +211,7 @@ TEST(PCDWithPCL, PaddedBinaryWithALyingHeaderOrGarbageIsStillRefused)
   lying.replace(at, 11, "POINTS 1010");
   lying.replace(lying.find("WIDTH 1000"), 10, "WIDTH 1010");
   lying.resize(lying.find("DATA binary\n") + 12 + 1000 * 12);
-  WriteText("lying.pcd", lying);
+  WriteFixture("lying.pcd", lying);
   vtkNew<MessageCatcher> msg;
   auto out = Read("lying.pcd", msg);
   EXPECT_NE(msg->Errors.find("truncated binary data"), std::string::npos) << msg->Errors;
@@ -227,7 +219,7 @@ TEST(PCDWithPCL, PaddedBinaryWithALyingHeaderOrGarbageIsStillRefused)
   // A byte that is not padding after the points (POINTS smaller than the data): refused, not read as points.
   std::string garbage = good;
   garbage[garbage.size() - 7] = '\x42';
-  WriteText("garbage_after.pcd", garbage);
+  WriteFixture("garbage_after.pcd", garbage);
   vtkNew<MessageCatcher> msg2;
   out = Read("garbage_after.pcd", msg2);
   EXPECT_NE(msg2->Errors.find("are not padding"), std::string::npos) << msg2->Errors;
@@ -253,14 +245,7 @@ TEST(PCDWithPCL, NormalEstimationGivesActiveNormalsAndCurvature)
     EXPECT_EQ(out->GetPointData()->GetArray(gone), nullptr) << gone;
   ASSERT_NE(out->GetPointData()->GetArray("curvature"), nullptr);
   // On the unit sphere every estimated normal is radial (either sign; PCL orients towards the viewpoint).
-  double worst = 1;
-  for (vtkIdType i = 0; i < 1000; ++i)
-  {
-    const double* p = out->GetPoint(i);
-    const double* nrm = normals->GetTuple3(i);
-    worst = std::min(worst, std::abs(p[0] * nrm[0] + p[1] * nrm[1] + p[2] * nrm[2]));
-  }
-  EXPECT_GT(worst, 0.98);
+  EXPECT_GT(MinRadialAlignment(out), 0.98);
 }
 
 TEST(PCDWithPCL, MlsSmoothingWithPaddingFieldsMatchesPCLsAsciiCopy)
@@ -304,8 +289,8 @@ TEST(PCDWithPCL, PackedRgbAndRgbaFromPCL)
   std::vector<std::vector<float>> rows;
   for (int i = 0; i < 3; ++i)
     rows.push_back({ float(i), 0.5f * i, -1.0f * i, Bits(colours[i]) });
-  WriteText("rgb.pcd", AsciiPCD("x y z rgb", "4 4 4 4", "F F F F", 3, 1, rows));
-  WriteText("rgba.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+  WriteFixture("rgb.pcd", AsciiPCD("x y z rgb", "4 4 4 4", "F F F F", 3, 1, rows));
+  WriteFixture("rgba.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                         "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
                         "property uchar alpha\nend_header\n0 0 0 255 0 0 128\n1 0 0 0 255 0 255\n0 1 0 16 32 48 7\n");
   for (const char* encoding : { "ascii", "binary", "binary_compressed" })
@@ -358,7 +343,7 @@ TEST(PCDWithPCL, OrganisedCloudsWithNaNPoints)
       }
     }
   ASSERT_EQ(valid.size(), 762u);
-  WriteText("organised.pcd", AsciiPCD("x y z", "4 4 4", "F F F", w, h, rows));
+  WriteFixture("organised.pcd", AsciiPCD("x y z", "4 4 4", "F F F", w, h, rows));
   for (const char* encoding : { "ascii", "binary", "binary_compressed" })
   {
     SCOPED_TRACE(encoding);
@@ -463,13 +448,8 @@ TEST(PCDWithPCL, PCLReadsWhatTheWriterWritesByDefault)
     vtkNew<MessageCatcher> rmsg;
     auto est = Read("ours_normals.pcd", rmsg);
     ASSERT_EQ(est->GetNumberOfPoints(), 500);
-    double radial = 1;
-    for (vtkIdType i = 0; i < 500; ++i)
-    {
-      const double* p = est->GetPoint(i);
-      const double* nrm = est->GetPointData()->GetNormals()->GetTuple3(i);
-      radial = std::min(radial, std::abs(p[0] * nrm[0] + p[1] * nrm[1] + p[2] * nrm[2]));
-    }
+    ASSERT_NE(est->GetPointData()->GetNormals(), nullptr);
+    const double radial = MinRadialAlignment(est);
     std::printf("MeshFree writer (encoding %d) -> pcl_normal_estimation: min |n . p| %g\n", encoding, radial);
     EXPECT_GT(radial, 0.97);
     // And our normals come back as ours, through PCL's PointNormal copy (pcl_mls_smoothing keeps normal_*

@@ -4,6 +4,8 @@
 #include "vtkMeshFreePCDWriter.h"
 #include "vtkMeshFreeXYZReader.h"
 
+#include "ReaderTestSupport.h"
+
 #include "vtkCellArray.h"
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
@@ -25,8 +27,9 @@
 
 #include <cmath>
 #include <fstream>
-#include <iterator>
 #include <string>
+
+using namespace meshfree_test;
 
 namespace
 {
@@ -37,39 +40,6 @@ std::string DataFile(const char* name)
 std::string OutFile(const std::string& name)
 {
   return std::string(MESHFREE_READERS_TEST_OUTPUT) + "/" + name;
-}
-void WriteText(const std::string& path, const std::string& text)
-{
-  std::ofstream(path, std::ios::binary) << text;
-}
-std::string ReadBytes(const std::string& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-// Catches the messages of vtkErrorMacro / vtkWarningMacro so that the test can check their text.
-class MessageCatcher : public vtkCommand
-{
-public:
-  static MessageCatcher* New() { return new MessageCatcher; }
-  void Execute(vtkObject*, unsigned long event, void* data) override
-  {
-    (event == vtkCommand::ErrorEvent ? this->Errors : this->Warnings) += static_cast<const char*>(data);
-  }
-  std::string Errors, Warnings;
-};
-
-template <class Reader>
-vtkSmartPointer<vtkPolyData> Read(const std::string& path, MessageCatcher* catcher, bool keepInvalid = false)
-{
-  vtkNew<Reader> reader;
-  reader->SetFileName(path.c_str());
-  reader->SetKeepInvalidPoints(keepInvalid);
-  reader->AddObserver(vtkCommand::ErrorEvent, catcher);
-  reader->AddObserver(vtkCommand::WarningEvent, catcher);
-  reader->Update();
-  return reader->GetOutput();
 }
 } // namespace
 
