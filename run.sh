@@ -16,7 +16,7 @@ packages=(
   libutfcpp-dev libhdf5-mpi-dev libnetcdf-dev libtiff-dev libtheora-dev libpng-dev libjpeg-dev
   libxml2-dev liblzma-dev liblz4-dev libglew-dev libgl2ps-dev libgdal-dev libfreetype-dev
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libexpat1-dev libboost-dev
-  mpi-default-dev python3-mpi4py libx11-dev libgl-dev libdouble-conversion-dev zlib1g-dev
+  mpi-default-dev python3-mpi4py libx11-dev libgl-dev libdouble-conversion-dev zlib1g-dev pcl-tools
   libpython3-dev python3-dev xvfb xauth
   libgtest-dev libbenchmark-dev liblzf-dev python3-numpy python3-scipy python3-matplotlib libtbb-dev
 )

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -112,8 +113,23 @@ void AppendValue(std::string& out, const Field& f, bool packedColor, const unsig
 {
   if (packedColor)
   {
+    // A TYPE F colour is written as the float it is (what PCL 1.13's ascii reader and any reader that takes
+    // TYPE F literally expect) unless that text would read as an integer, i.e. as the bits themselves (PCL >=
+    // 1.8's convention: 0, integral values, NaN and infinities); TYPE U as the integer.
     std::uint32_t bits;
     std::memcpy(&bits, src, 4);
+    if (f.Type == 'F')
+    {
+      float v;
+      std::memcpy(&v, src, 4);
+      char buf[40];
+      char* end = std::to_chars(buf, buf + sizeof(buf), v).ptr;
+      if (std::isfinite(v) && std::find_if(buf, end, [](char c) { return c == '.' || c == 'e'; }) != end)
+      {
+        out.append(buf, static_cast<std::size_t>(end - buf));
+        return;
+      }
+    }
     AppendNumber(out, bits);
     return;
   }

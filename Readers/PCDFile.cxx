@@ -255,6 +255,8 @@ std::uint64_t DropInvalidPoints(Cloud& cloud, std::vector<std::uint64_t>* keptIn
       compact(cloud.Columns[c], cloud.Head.Fields[cloud.ColumnField[c]].Bytes());
     if (cloud.PointsSize)
       compact(cloud.Points, 3 * static_cast<std::size_t>(cloud.PointsSize));
+    if (cloud.NormalsSize)
+      compact(cloud.Normals, 3 * static_cast<std::size_t>(cloud.NormalsSize));
     cloud.Head.Points = kept.size();
   }
   const std::uint64_t dropped = firstBad < n ? n - kept.size() : 0;

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -94,6 +95,17 @@ void StridedCopy(const unsigned char* src, std::size_t srcStride, std::uint64_t 
       for (std::uint64_t i = 0; i < n; ++i)
         std::memcpy(dst + i * dstStride, src + i * srcStride, bytes);
   }
+}
+
+// What may follow the records of a binary data section: PCL's writers size binary files beyond the data
+// (PCL 1.13 leaves up to a page of zero bytes after the last point), and other writers end with a newline.
+// Anything else, or more zeros than the largest page size, means that POINTS does not describe the data.
+bool IsTrailingPadding(const char* tail, std::size_t bytes)
+{
+  constexpr std::size_t MaxPageBytes = std::size_t(64) << 10;
+  if (bytes <= 2 && std::all_of(tail, tail + bytes, [](char c) { return c == '\n' || c == '\r'; }))
+    return true;
+  return bytes < MaxPageBytes && std::all_of(tail, tail + bytes, [](char c) { return c == '\0'; });
 }
 
 bool ValidateField(const Field& f, std::string& error)
@@ -315,15 +327,13 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
         std::to_string(need) + " needed)";
       return false;
     }
-    std::size_t extra = available - need;
-    const char* tail = data + header.DataStart + need;
-    for (std::size_t i = 0; i < extra; ++i)
-      if (!(tail[i] == '\n' || tail[i] == '\r') || extra > 2)
-      {
-        error = std::to_string(extra) + " bytes after the " + std::to_string(n) +
-          " points: POINTS does not match the data";
-        return false;
-      }
+    const std::size_t extra = available - need;
+    if (!IsTrailingPadding(data + header.DataStart + need, extra))
+    {
+      error = std::to_string(extra) + " bytes after the " + std::to_string(n) +
+        " points are not padding: POINTS does not match the data";
+      return false;
+    }
   }
   else if (header.Data == Encoding::BinaryCompressed && (n > 0 || available >= 8))
   {
@@ -376,29 +386,41 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
   }
 
   cloud.Head = header;
-  // Where each field goes: x, y, z (one floating type, COUNT 1) into the interleaved points when asked,
-  // every other non-padding field into its own column.
-  int xyz[3] = { header.FieldIndex("x"), header.FieldIndex("y"), header.FieldIndex("z") };
-  bool interleave = interleaveXYZ;
-  for (int k = 0; k < 3 && interleave; ++k)
-  {
-    interleave = xyz[k] >= 0 && header.Fields[xyz[k]].Type == 'F' && header.Fields[xyz[k]].Count == 1 &&
-      header.Fields[xyz[k]].Size == header.Fields[xyz[0]].Size;
-  }
+  // Where each field goes: x, y, z and normal_x, normal_y, normal_z (each triple one floating type, COUNT 1)
+  // into the interleaved points and normals when asked, every other non-padding field into its own column.
   std::vector<detail::Target> targets(header.Fields.size());
   auto outOfMemory = [&] {
     cloud = Cloud();
     error = "out of memory for " + std::to_string(n) + " points";
     return false;
   };
-  if (interleave)
+  struct Triple
   {
-    const std::size_t s = static_cast<std::size_t>(header.Fields[xyz[0]].Size);
-    if (!cloud.Points.Allocate(n * 3 * s))
+    const char* Names[3];
+    Buffer Cloud::*Storage;
+    int Cloud::*Size;
+  };
+  const Triple triples[] = { { { "x", "y", "z" }, &Cloud::Points, &Cloud::PointsSize },
+    { { "normal_x", "normal_y", "normal_z" }, &Cloud::Normals, &Cloud::NormalsSize } };
+  for (const Triple& t : triples)
+  {
+    int field[3] = { -1, -1, -1 };
+    bool interleave = interleaveXYZ;
+    for (int k = 0; k < 3 && interleave; ++k)
+    {
+      field[k] = header.FieldIndex(t.Names[k]);
+      interleave = field[k] >= 0 && header.Fields[field[k]].Type == 'F' && header.Fields[field[k]].Count == 1 &&
+        header.Fields[field[k]].Size == header.Fields[field[0]].Size;
+    }
+    if (!interleave)
+      continue;
+    const std::size_t s = static_cast<std::size_t>(header.Fields[field[0]].Size);
+    Buffer& storage = cloud.*t.Storage;
+    if (!storage.Allocate(n * 3 * s))
       return outOfMemory();
-    cloud.PointsSize = static_cast<int>(s);
+    cloud.*t.Size = static_cast<int>(s);
     for (int k = 0; k < 3; ++k)
-      targets[xyz[k]] = { cloud.Points.Data() + k * s, 3 * s };
+      targets[field[k]] = { storage.Data() + k * s, 3 * s };
   }
   for (std::size_t i = 0; i < header.Fields.size(); ++i)
   {

@@ -10,7 +10,10 @@
 // - binary_compressed: uint32 compressed size, uint32 uncompressed size, then LZF bytes that expand to
 //   one block per field (structure of arrays). PCL leaves the padding fields ("_") out of these blocks.
 // - ascii: one point per line; PCL leaves the padding fields out, and writes the packed "rgb" float as
-//   the uint32 of its bits (older versions wrote the float itself): both are accepted.
+//   the uint32 of its bits (older versions wrote the float itself): both are accepted. PCL 1.13's ascii
+//   reader takes the float only, so that is what the encoder writes wherever it cannot read as an integer.
+// - binary: PCL's writers leave zero bytes after the data (PCL 1.13: up to a page); they are accepted, any
+//   other trailing bytes refused.
 #ifndef meshfree_PCDFormat_h
 #define meshfree_PCDFormat_h
 
@@ -86,9 +89,10 @@ private:
 };
 
 /// A decoded cloud: one column per non-padding field (Points x Count values of the field's own type,
-/// interleaved), in the order of Header::Fields. When decoded with interleaveXYZ and the fields x, y, z are
-/// one floating type with COUNT 1, they go straight into Points as x y z triples (PointsSize 4: float,
-/// 8: double), the layout of vtkPoints, and have no column.
+/// interleaved), in the order of Header::Fields. When decoded with interleaveXYZ (the VTK reader's layout)
+/// and the fields x, y, z are one floating type with COUNT 1, they go straight into Points as x y z triples
+/// (PointsSize 4: float, 8: double), the layout of vtkPoints, and have no column; likewise PCL's normal_x,
+/// normal_y, normal_z go into Normals as triples (NormalsSize 4 or 8).
 struct Cloud
 {
   Header Head;
@@ -96,6 +100,8 @@ struct Cloud
   std::vector<Buffer> Columns;
   Buffer Points;
   int PointsSize = 0; // 0: no interleaved points
+  Buffer Normals;
+  int NormalsSize = 0; // 0: no interleaved normals
 };
 
 /// Parses the header at the start of data. On failure returns false and a message naming the problem.
@@ -108,7 +114,7 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
 bool ReadFile(const std::string& path, Cloud& cloud, std::string& error, bool interleaveXYZ = false);
 
 /// Removes the points whose x, y or z is NaN or infinite (PCL's marker of invalid points), from every
-/// column (and from Points). keptIndex (optional) receives the original index of each kept point, or
+/// column (and from Points and Normals). keptIndex (optional) receives the original index of each kept point, or
 /// nothing when no point was dropped. Returns how many went.
 std::uint64_t DropInvalidPoints(Cloud& cloud, std::vector<std::uint64_t>* keptIndex = nullptr);
 

@@ -157,8 +157,20 @@ int vtkMeshFreePCDReader::RequestData(
   }
   output->SetPoints(points);
 
-  // Every other field: a point array that adopts the decoded column (no copy).
+  // PCL's normal_x, normal_y, normal_z: one 3-component array, the active normals (glyphs, surfaces).
   std::set<std::string> names;
+  if (cloud.NormalsSize)
+  {
+    vtkSmartPointer<vtkDataArray> normals;
+    normals.TakeReference(vtkDataArray::CreateDataArray(cloud.NormalsSize == 4 ? VTK_FLOAT : VTK_DOUBLE));
+    normals->SetNumberOfComponents(3);
+    meshfree::AdoptBulk(normals, cloud.Normals.Release(), 3 * n);
+    normals->SetName("Normals");
+    output->GetPointData()->SetNormals(normals);
+    names.insert("Normals");
+  }
+
+  // Every other field: a point array that adopts the decoded column (no copy).
   for (std::size_t c = 0; c < cloud.Columns.size(); ++c)
   {
     if (static_cast<int>(c) == coord[0] || static_cast<int>(c) == coord[1] || static_cast<int>(c) == coord[2])

@@ -5,9 +5,14 @@
  * Output: a vtkPolyData with one vertex cell per point.
  * - The fields `x`, `y`, `z` are the points (float when all three are 4-byte floats, else double; a missing
  *   one is 0).
+ * - PCL's `normal_x`, `normal_y`, `normal_z` (one floating type, COUNT 1) become one 3-component array
+ *   `Normals`, the active normals of the point data (so that glyphs and surface filters use them).
  * - Every other field is a point array named as in the file, of the field's own type (SIZE 1/2/4/8, TYPE
- *   I/U/F), with COUNT components. PCL's packed colour fields `rgb` (float) and `rgba` (uint32) become
- *   unsigned-char arrays `rgb` (3 components) and `rgba` (4). Padding fields (`_`) are skipped.
+ *   I/U/F), with COUNT components (`curvature` stays `curvature`). PCL's packed colour fields `rgb` (float)
+ *   and `rgba` (uint32) become unsigned-char arrays `rgb` (3 components) and `rgba` (4). Padding fields
+ *   (`_`) are skipped.
+ * - binary data may be followed by zero bytes (PCL's writers pad files up to a page); any other bytes after
+ *   the POINTS records mean that the header does not describe the data, and the file is refused.
  * - Field data: `Viewpoint` (tx ty tz qw qx qy qz) and `OrganizedDimensions` (WIDTH, HEIGHT).
  * - Points with a NaN (or infinite) x, y or z, PCL's marker of invalid points, are dropped with a warning
  *   giving their count, unless KeepInvalidPoints is on. When points of an organised cloud (HEIGHT > 1) are

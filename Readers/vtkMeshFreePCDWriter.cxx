@@ -12,7 +12,9 @@
 #include "vtkSmartPointer.h"
 #include "vtkUnsignedCharArray.h"
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <set>
 #include <string>
@@ -43,6 +45,11 @@ bool PCDType(int vtkType, int& size, char& type)
     case VTK_DOUBLE: size = 8, type = 'F'; return true;
     default: return false;
   }
+}
+
+bool IsNormalsArray(vtkDataArray* a)
+{
+  return a && a->GetNumberOfComponents() == 3 && (a->GetDataType() == VTK_FLOAT || a->GetDataType() == VTK_DOUBLE);
 }
 
 std::string FieldName(const char* name, std::size_t index)
@@ -97,38 +104,56 @@ void vtkMeshFreePCDWriter::WriteData()
   std::vector<vtkSmartPointer<vtkDataArray>> keep;
   storage.reserve(4 + input->GetPointData()->GetNumberOfArrays());
 
-  // x, y, z in the points' own precision.
+  // x, y, z as 4-byte floats, the format's convention that PCL's point types read; 8-byte doubles only when
+  // asked (and the points are double).
   vtkPoints* points = input->GetPoints();
-  const bool isFloat = points && points->GetDataType() == VTK_FLOAT;
-  for (int k = 0; k < 3; ++k)
-  {
-    pcd::Field f;
-    f.Name = std::string(1, "xyz"[k]);
-    f.Size = isFloat ? 4 : 8;
-    f.Type = 'F';
-    header.Fields.push_back(f);
-    storage.emplace_back(static_cast<std::size_t>(n) * f.Size);
-    unsigned char* dst = storage.back().data();
-    for (vtkIdType i = 0; i < n; ++i)
+  const bool doublePoints = this->WriteDoubleCoordinates && points && points->GetDataType() != VTK_FLOAT;
+  double worstRounding = 0.0;
+  auto addComponentFields = [&](vtkDataArray* source, const std::string& prefix, bool asDouble) {
+    for (int k = 0; k < 3; ++k)
     {
-      const double v = points->GetPoint(i)[k];
-      if (isFloat)
+      pcd::Field f;
+      f.Name = prefix + "xyz"[k];
+      f.Size = asDouble ? 8 : 4;
+      header.Fields.push_back(f);
+      storage.emplace_back(static_cast<std::size_t>(n) * f.Size);
+      unsigned char* dst = storage.back().data();
+      for (vtkIdType i = 0; i < n; ++i)
       {
+        const double v = source->GetComponent(i, k);
         const float x = static_cast<float>(v);
-        std::memcpy(dst + 4 * i, &x, 4);
+        std::memcpy(dst + f.Size * i, asDouble ? static_cast<const void*>(&v) : &x, f.Size);
+        if (!asDouble && std::isfinite(v))
+          worstRounding = std::max(worstRounding, std::abs(static_cast<double>(x) - v));
       }
-      else
-        std::memcpy(dst + 8 * i, &v, 8);
+      columns.push_back(dst);
     }
-    columns.push_back(dst);
-  }
+  };
+  addComponentFields(n > 0 ? points->GetData() : nullptr, "", doublePoints);
+  const double size = n > 0 ? input->GetLength() : 0.0; // the bounding box's diagonal
+  if (size > 0.0 && worstRounding > 1e-5 * size) // a single point (size 0) has no scale to lose
+    vtkWarningMacro("'" << this->FileName << "': x, y, z written as 4-byte floats (the .pcd convention that PCL "
+                        << "reads) move points by up to " << worstRounding << " (the cloud spans " << size
+                        << "); switch WriteDoubleCoordinates on to keep doubles (most PCL tools cannot read those).");
 
-  std::set<std::string> used = { "x", "y", "z" };
+  // The normals (the active ones, or a 3-component array named Normals) as PCL's normal_x, normal_y, normal_z,
+  // in the precision of the coordinates.
   vtkPointData* pd = input->GetPointData();
+  vtkDataArray* normals = pd->GetNormals();
+  if (!IsNormalsArray(normals))
+    normals = pd->GetArray("Normals");
+  if (!IsNormalsArray(normals))
+    normals = nullptr;
+  if (normals)
+    addComponentFields(normals, "normal_", doublePoints && normals->GetDataType() == VTK_DOUBLE);
+
+  std::set<std::string> used;
+  for (const pcd::Field& f : header.Fields)
+    used.insert(f.Name);
   for (int a = 0; a < pd->GetNumberOfArrays(); ++a)
   {
     vtkDataArray* array = pd->GetArray(a);
-    if (!array)
+    if (!array || array == normals)
       continue;
     const std::string name = FieldName(array->GetName(), static_cast<std::size_t>(a));
     const int comps = array->GetNumberOfComponents();
@@ -201,4 +226,5 @@ void vtkMeshFreePCDWriter::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
   os << indent << "Encoding: " << this->Encoding << "\n";
+  os << indent << "WriteDoubleCoordinates: " << this->WriteDoubleCoordinates << "\n";
 }

@@ -251,6 +251,23 @@ TEST(PCDFormat, PCLBinaryWithPaddingFields)
   EXPECT_EQ(reinterpret_cast<const float*>(c.Columns[0].Data())[2], -2.0f);
 }
 
+TEST(PCDFormat, InterleavedNormalsFollowTheirPoints)
+{
+  Cloud c;
+  std::string error;
+  ASSERT_TRUE(ReadFile(DataFile("pcl_pointnormal_binary.pcd"), c, error, /*interleaveXYZ=*/true)) << error;
+  ASSERT_EQ(c.PointsSize, 4);
+  ASSERT_EQ(c.NormalsSize, 4);
+  ASSERT_EQ(c.Columns.size(), 1u); // curvature
+  EXPECT_EQ(c.Head.Fields[c.ColumnField[0]].Name, "curvature");
+  EXPECT_EQ(DropInvalidPoints(c), 1u);
+  ASSERT_EQ(c.Normals.Bytes(), 3u * 12u);
+  const float* n = reinterpret_cast<const float*>(c.Normals.Data());
+  const float expected[9] = { 0, 0, 1, 0.6f, 0.8f, 0, 1, 0, 0 };
+  for (int i = 0; i < 9; ++i)
+    EXPECT_EQ(n[i], expected[i]) << i;
+}
+
 TEST(PCDFormat, PCLCompressedOrganisedWithoutPaddingBlocks)
 {
   Cloud c;
@@ -267,6 +284,58 @@ TEST(PCDFormat, PCLCompressedOrganisedWithoutPaddingBlocks)
   std::memcpy(rgba, c.Columns[3].Data(), 16);
   EXPECT_EQ(rgba[0], 0xFF102030u);
   EXPECT_EQ(rgba[1], 0x80FF0000u);
+}
+
+TEST(PCDFormat, BinaryWithPCLsPagePadding)
+{
+  // PCL 1.13 sizes a binary file to the data plus a page: zero bytes follow the last point.
+  const Synthetic s = MakeCloud(3, 1, 10);
+  for (std::size_t padding : { std::size_t(1), std::size_t(2), std::size_t(3926), std::size_t(65535) })
+  {
+    SCOPED_TRACE(padding);
+    const std::string bytes = Encoded(s, Encoding::Binary) + std::string(padding, '\0');
+    Cloud c;
+    std::string error;
+    ASSERT_TRUE(Decode(bytes.data(), bytes.size(), c, error)) << error;
+    ExpectSameCloud(s, c);
+  }
+}
+
+TEST(PCDFormat, AsciiPackedRgbIsTheFloatPCLReads)
+{
+  // PCL 1.13 reads an ascii TYPE F rgb as a float (text "65287" becomes 65287.0f, another colour): colours
+  // are written as their float, the bits as an integer only where the float's text would read as one.
+  std::vector<std::uint32_t> bits = { 0x0000FF07u, 0x00FF0000u, 0x3F800000u, 0xFFFFFFFFu, 0x80000000u, 0u,
+    0x7F800000u };
+  for (std::uint32_t c = 1; c < (1u << 24); c += 97)
+    bits.push_back(c); // a sample of every 0x00RRGGBB colour, most of them denormal floats
+  Synthetic s;
+  s.Head.Width = s.Head.Points = bits.size();
+  Field f;
+  f.Name = "rgb";
+  s.Head.Fields.push_back(f);
+  s.Columns.emplace_back(bits.size() * 4);
+  std::memcpy(s.Columns[0].data(), bits.data(), bits.size() * 4);
+  const std::string text = Encoded(s, Encoding::Ascii);
+  const std::size_t data = text.find("DATA ascii\n") + 11;
+  std::vector<std::string> lines;
+  for (std::size_t p = data; p < text.size();)
+  {
+    const std::size_t nl = text.find('\n', p);
+    lines.push_back(text.substr(p, nl - p));
+    p = nl + 1;
+  }
+  EXPECT_EQ(lines[0], "9.1487e-41"); // shortest text that reads back as these bits
+  EXPECT_EQ(lines[1], "2.3418052e-38");
+  EXPECT_EQ(lines[2], "1065353216"); // 1.0f: "1" would read as the bits 0x00000001
+  EXPECT_EQ(lines[3], "4294967295"); // NaN
+  EXPECT_EQ(lines[4], "2147483648"); // -0
+  EXPECT_EQ(lines[5], "0");
+  EXPECT_EQ(lines[6], "2139095040"); // infinity
+  Cloud c;
+  std::string error;
+  ASSERT_TRUE(Decode(text.data(), text.size(), c, error)) << error;
+  ExpectSameCloud(s, c);
 }
 
 TEST(PCDFormat, MalformedFilesFailWithAMessage)
@@ -299,7 +368,9 @@ TEST(PCDFormat, MalformedFilesFailWithAMessage)
     { head + "WIDTH 100000000000\nPOINTS 100000000000\nDATA ascii\n1 2 3\n", "truncated ascii" },
     { head + "WIDTH 18446744073709551615\nPOINTS 18446744073709551615\nDATA binary\n", "too large" },
     { head + "WIDTH 2\nPOINTS 2\nDATA binary\n" + std::string(23, '\0'), "truncated binary" },
-    { head + "WIDTH 1\nPOINTS 1\nDATA binary\n" + std::string(12 + 5, '\0'), "POINTS does not match" },
+    { head + "WIDTH 1\nPOINTS 1\nDATA binary\n" + std::string(12 + 4, '\0') + "\x01", "POINTS does not match" },
+    { head + "WIDTH 1\nPOINTS 1\nDATA binary\n" + std::string(12, '\0') + "\n\n\n", "are not padding" },
+    { head + "WIDTH 1\nPOINTS 1\nDATA binary\n" + std::string(12 + (64 << 10), '\0'), "are not padding" },
     { head + "WIDTH 1\nPOINTS 1\nDATA binary_compressed\n" + std::string(4, '\0'), "no size words" },
   };
   for (const Case& c : cases)

@@ -4,6 +4,8 @@
 #include "vtkMeshFreePCDWriter.h"
 #include "vtkMeshFreeXYZReader.h"
 
+#include "ReaderTestSupport.h"
+
 #include "vtkCellArray.h"
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
@@ -27,6 +29,8 @@
 #include <fstream>
 #include <string>
 
+using namespace meshfree_test;
+
 namespace
 {
 std::string DataFile(const char* name)
@@ -36,34 +40,6 @@ std::string DataFile(const char* name)
 std::string OutFile(const std::string& name)
 {
   return std::string(MESHFREE_READERS_TEST_OUTPUT) + "/" + name;
-}
-void WriteText(const std::string& path, const std::string& text)
-{
-  std::ofstream(path, std::ios::binary) << text;
-}
-
-// Catches the messages of vtkErrorMacro / vtkWarningMacro so that the test can check their text.
-class MessageCatcher : public vtkCommand
-{
-public:
-  static MessageCatcher* New() { return new MessageCatcher; }
-  void Execute(vtkObject*, unsigned long event, void* data) override
-  {
-    (event == vtkCommand::ErrorEvent ? this->Errors : this->Warnings) += static_cast<const char*>(data);
-  }
-  std::string Errors, Warnings;
-};
-
-template <class Reader>
-vtkSmartPointer<vtkPolyData> Read(const std::string& path, MessageCatcher* catcher, bool keepInvalid = false)
-{
-  vtkNew<Reader> reader;
-  reader->SetFileName(path.c_str());
-  reader->SetKeepInvalidPoints(keepInvalid);
-  reader->AddObserver(vtkCommand::ErrorEvent, catcher);
-  reader->AddObserver(vtkCommand::WarningEvent, catcher);
-  reader->Update();
-  return reader->GetOutput();
 }
 } // namespace
 
@@ -199,6 +175,100 @@ TEST(ReadersVTK, PCDWriterRoundTripsThroughTheReader)
       ASSERT_EQ(b->GetValue(i), big->GetValue(i));
     }
   }
+}
+
+TEST(ReadersVTK, PCDReaderMakesPCLNormalsTheActiveNormals)
+{
+  // x y z _ normal_x normal_y normal_z _ curvature (PCL's PointNormal, binary); point 2 is invalid (NaN).
+  vtkNew<MessageCatcher> msg;
+  auto out = Read<vtkMeshFreePCDReader>(DataFile("pcl_pointnormal_binary.pcd"), msg);
+  EXPECT_TRUE(msg->Errors.empty()) << msg->Errors;
+  ASSERT_EQ(out->GetNumberOfPoints(), 3);
+  auto* normals = vtkFloatArray::SafeDownCast(out->GetPointData()->GetNormals());
+  ASSERT_NE(normals, nullptr);
+  EXPECT_STREQ(normals->GetName(), "Normals");
+  ASSERT_EQ(normals->GetNumberOfComponents(), 3);
+  EXPECT_EQ(normals->GetTypedComponent(0, 2), 1.0f);
+  EXPECT_EQ(normals->GetTypedComponent(1, 0), 0.6f);
+  EXPECT_EQ(normals->GetTypedComponent(1, 1), 0.8f);
+  EXPECT_EQ(normals->GetTypedComponent(2, 0), 1.0f); // the file's point 3, after the dropped one
+  auto* curvature = out->GetPointData()->GetArray("curvature");
+  ASSERT_NE(curvature, nullptr);
+  EXPECT_EQ(curvature->GetComponent(1, 0), 0.25);
+  EXPECT_EQ(out->GetPointData()->GetNumberOfArrays(), 2); // Normals, curvature: no normal_x, no "_"
+
+  // Normals that are not one floating triple stay separate arrays.
+  const std::string path = OutFile("normals_mixed.pcd");
+  WriteText(path, "FIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 8\nTYPE F F F F F F\nWIDTH 1\nPOINTS 1\n"
+                  "DATA ascii\n0 0 0 1 0 0\n");
+  out = Read<vtkMeshFreePCDReader>(path, msg);
+  EXPECT_EQ(out->GetPointData()->GetNormals(), nullptr);
+  EXPECT_NE(out->GetPointData()->GetArray("normal_z"), nullptr);
+}
+
+TEST(ReadersVTK, PCDWriterWritesNormalsAsPCLsFieldsAndFloatsByDefault)
+{
+  vtkNew<vtkPolyData> pd;
+  vtkNew<vtkPoints> pts; // double points, as VTK pipelines make them
+  vtkNew<vtkDoubleArray> normals;
+  normals->SetName("MyNormals");
+  normals->SetNumberOfComponents(3);
+  for (int i = 0; i < 10; ++i)
+  {
+    pts->InsertNextPoint(0.1 * i, 1.0 / 3.0, -2.0 * i);
+    normals->InsertNextTuple3(0.6, 0.0, -0.8);
+  }
+  pd->SetPoints(pts);
+  pd->GetPointData()->SetNormals(normals);
+  const std::string path = OutFile("writer_normals.pcd");
+  vtkNew<vtkMeshFreePCDWriter> writer;
+  writer->SetInputData(pd);
+  writer->SetFileName(path.c_str());
+  EXPECT_EQ(writer->GetWriteDoubleCoordinates(), 0);
+  ASSERT_EQ(writer->Write(), 1);
+  EXPECT_NE(ReadBytes(path).find("FIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n"),
+    std::string::npos);
+  vtkNew<MessageCatcher> msg;
+  auto out = Read<vtkMeshFreePCDReader>(path, msg);
+  ASSERT_EQ(out->GetNumberOfPoints(), 10);
+  EXPECT_EQ(out->GetPoints()->GetDataType(), VTK_FLOAT);
+  for (int i = 0; i < 10; ++i)
+    for (int k = 0; k < 3; ++k)
+      ASSERT_EQ(out->GetPoint(i)[k], static_cast<float>(pts->GetPoint(i)[k]));
+  ASSERT_NE(out->GetPointData()->GetNormals(), nullptr);
+  EXPECT_EQ(out->GetPointData()->GetNormals()->GetComponent(9, 2), -0.8f);
+}
+
+TEST(ReadersVTK, PCDWriterDoubleCoordinatesOnRequest)
+{
+  // Far from the origin floats move points by centimetres: the writer warns, and keeps doubles on request.
+  vtkNew<vtkPolyData> cloud;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (int i = 0; i < 20; ++i)
+    points->InsertNextPoint(512345.678 + 0.001 * i, 4123456.789 - 0.002 * i, 12.5 + 1e-6 * i);
+  cloud->SetPoints(points);
+  vtkNew<vtkMeshFreePCDWriter> writer;
+  vtkNew<MessageCatcher> msg;
+  writer->AddObserver(vtkCommand::WarningEvent, msg);
+  writer->SetInputData(cloud);
+  writer->SetFileName(OutFile("far.pcd").c_str());
+  ASSERT_EQ(writer->Write(), 1);
+  EXPECT_NE(msg->Warnings.find("WriteDoubleCoordinates"), std::string::npos) << msg->Warnings;
+  EXPECT_NE(ReadBytes(OutFile("far.pcd")).find("SIZE 4 4 4"), std::string::npos);
+  writer->WriteDoubleCoordinatesOn();
+  vtkNew<MessageCatcher> quiet;
+  writer->AddObserver(vtkCommand::WarningEvent, quiet);
+  ASSERT_EQ(writer->Write(), 1);
+  EXPECT_TRUE(quiet->Warnings.empty()) << quiet->Warnings;
+  EXPECT_NE(ReadBytes(OutFile("far.pcd")).find("SIZE 8 8 8"), std::string::npos);
+  vtkNew<MessageCatcher> rmsg;
+  auto out = Read<vtkMeshFreePCDReader>(OutFile("far.pcd"), rmsg);
+  ASSERT_EQ(out->GetNumberOfPoints(), 20);
+  EXPECT_EQ(out->GetPoints()->GetDataType(), VTK_DOUBLE);
+  for (vtkIdType i = 0; i < 20; ++i)
+    for (int k = 0; k < 3; ++k)
+      ASSERT_EQ(out->GetPoint(i)[k], points->GetPoint(i)[k]);
 }
 
 TEST(ReadersVTK, BadFilesGiveAnErrorAndAnEmptyOutput)

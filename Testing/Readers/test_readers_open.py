@@ -103,15 +103,26 @@ data = meshfree_test.fetch(reader)
 assert data.GetNumberOfPoints() == 3
 assert np.asarray(data.PointData["rgb"]).tolist()[0] == [255, 0, 0]
 
+# PCL's PointNormal: normal_x normal_y normal_z become the active normals, named Normals.
+fixture = os.path.join(os.environ["MESHFREE_READERS_TEST_DATA"], "pcl_pointnormal_binary.pcd")
+data = meshfree_test.fetch(simple.OpenDataFile(fixture))
+normals = data.VTKObject.GetPointData().GetNormals()
+assert normals is not None and normals.GetName() == "Normals", normals
+assert np.array_equal(np.asarray(data.PointData["Normals"])[1], np.float32([0.6, 0.8, 0.0]))
+assert "curvature" in data.PointData.keys() and "normal_x" not in data.PointData.keys()
+
+# The writer: x y z as 4-byte floats by default (what PCL reads), doubles with WriteDoubleCoordinates.
 source = simple.OpenDataFile(path("cloud.pts"))
 for encoding in ("ascii", "binary", "binary_compressed"):
-    target = path("roundtrip_%s.pcd" % encoding)
-    simple.SaveData(target, proxy=source, Encoding=encoding)
-    with open(target, "rb") as f:
-        text = f.read(400)
-    assert ("DATA %s\n" % encoding).encode() in text, text
-    back = meshfree_test.fetch(simple.OpenDataFile(target))
-    assert np.array_equal(np.asarray(back.Points), xyz)
-    assert np.array_equal(np.asarray(back.PointData["Intensity"]), np.full(50, -5.0))
-    assert np.array_equal(np.asarray(back.PointData["RGB"]), np.tile([10, 20, 30], (50, 1)))
+    for double in (0, 1):
+        target = path("roundtrip_%s_%d.pcd" % (encoding, double))
+        simple.SaveData(target, proxy=source, Encoding=encoding, WriteDoubleCoordinates=double)
+        with open(target, "rb") as f:
+            text = f.read(400)
+        assert ("DATA %s\n" % encoding).encode() in text, text
+        assert (b"SIZE 8 8 8 " if double else b"SIZE 4 4 4 ") in text, text
+        back = meshfree_test.fetch(simple.OpenDataFile(target))
+        assert np.array_equal(np.asarray(back.Points), xyz if double else xyz.astype(np.float32))
+        assert np.array_equal(np.asarray(back.PointData["Intensity"]), np.full(50, -5.0))
+        assert np.array_equal(np.asarray(back.PointData["RGB"]), np.tile([10, 20, 30], (50, 1)))
 print("OK")
