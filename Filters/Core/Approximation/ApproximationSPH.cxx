@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // SPH interpolation (thesis 2.3, 5.10): A(x) = sum_j A_j V_j W(|x - x_j|, h), optionally Shepard-normalised.
 #include "Approximation/Approximation.h"
+#include "Common/Parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -42,11 +43,10 @@ bool Approximator::PrepareSPHVolumes()
   const double unitLength = this->SphUnitLength;
   const std::vector<Index>& order = this->Points.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
-#pragma omp parallel
-  {
-    FitScratch s;
-#pragma omp for schedule(dynamic, 256)
-    for (Index p = 0; p < nv; ++p)
+  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  ParallelFor(nv, 256, [&](Index begin, Index end) {
+    FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+    for (Index p = begin; p < end; ++p)
     {
       const Index id = order[p];
       const double* x = &this->Coordinates[3 * id];
@@ -61,7 +61,7 @@ bool Approximator::PrepareSPHVolumes()
       const double hd = std::pow(h / unitLength, dim);
       this->SphVolumes[id] = sum > 0.0 ? hd / sum : 0.0;
     }
-  }
+  });
   return true;
 }
 
