@@ -272,6 +272,9 @@ bool Approximator::Evaluate(
     const Counts counts = ParallelReduce(end - begin, global ? 1024 : 64, Counts(),
       [&](Index b0, Index b1) {
         FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+        // Each block starts without the previous query's neighbour radius: the warm start may list the same
+        // neighbours in another order, so a block's sums must not depend on which thread ran which block before.
+        s.RadiusGuess = 0.0;
         Counts mine;
         for (Index i = begin + b0; i < begin + b1; ++i)
         {

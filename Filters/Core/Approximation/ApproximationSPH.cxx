@@ -43,11 +43,18 @@ bool Approximator::PrepareSPHVolumes()
   const double unitLength = this->SphUnitLength;
   const std::vector<Index>& order = this->Points.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
+  // Fixed blocks of points, each starting without the previous query's neighbour radius (the warm start may
+  // list the same neighbours in another order): the sums do not depend on which thread ran which block before.
+  constexpr Index block = 256;
   std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
-  ParallelFor(nv, 256, [&](Index begin, Index end) {
+  ParallelFor((nv + block - 1) / block, 1, [&](Index b0, Index b1) {
     FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
-    for (Index p = begin; p < end; ++p)
+    for (Index p = b0 * block; p < std::min(nv, b1 * block); ++p)
     {
+      if (p % block == 0)
+      {
+        s.RadiusGuess = 0.0;
+      }
       const Index id = order[p];
       const double* x = &this->Coordinates[3 * id];
       double h = 1.0;
