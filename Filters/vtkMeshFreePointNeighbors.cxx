@@ -12,6 +12,7 @@
 #include "vtkPoints.h"
 
 #include "Common/NeighborGrid.h"
+#include "Common/Parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +74,17 @@ int vtkMeshFreePointNeighbors::RequestData(
   char* validPtr = valid->GetPointer(0);
   vtkIdType* radiusPtr = radius > 0 ? inRadius->GetPointer(0) : nullptr;
   const vtkIdType chunk = 4096;
+  struct Buffers
+  {
+    std::vector<meshfree::Index> Ids, RadiusIds;
+    std::vector<double> Dist2;
+  };
+  std::vector<Buffers> buffers(static_cast<size_t>(meshfree::MaxThreads()));
+  for (Buffers& b : buffers)
+  {
+    b.Ids.resize(k + 1);
+    b.Dist2.resize(k + 1);
+  }
   for (vtkIdType begin = 0; begin < n; begin += chunk)
   {
     if (this->GetAbortExecute())
@@ -80,13 +92,12 @@ int vtkMeshFreePointNeighbors::RequestData(
       break;
     }
     const vtkIdType end = std::min(n, begin + chunk);
-#pragma omp parallel
-    {
-      std::vector<meshfree::Index> ids(k + 1);
-      std::vector<double> dist2(k + 1);
-      std::vector<meshfree::Index> radiusIds;
-#pragma omp for schedule(dynamic, 256)
-      for (vtkIdType i = begin; i < end; ++i)
+    meshfree::ParallelFor(end - begin, 256, [&](meshfree::Index b0, meshfree::Index b1) {
+      Buffers& mine = buffers[static_cast<size_t>(meshfree::ThreadIndex())];
+      std::vector<meshfree::Index>& ids = mine.Ids;
+      std::vector<double>& dist2 = mine.Dist2;
+      std::vector<meshfree::Index>& radiusIds = mine.RadiusIds;
+      for (vtkIdType i = begin + b0; i < begin + b1; ++i)
       {
         const double* x = &xyz[3 * i];
         const bool finite = std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
@@ -122,7 +133,7 @@ int vtkMeshFreePointNeighbors::RequestData(
           radiusPtr[i] = std::max<vtkIdType>(0, static_cast<vtkIdType>(radiusIds.size()) - 1);
         }
       }
-    }
+    });
     this->UpdateProgress(static_cast<double>(end) / n);
   }
 

@@ -3,14 +3,11 @@
 // global fits of LS (3.1-3.7) and WLS (3.8-3.15).
 #include "Approximation/Approximation.h"
 #include "Approximation/ApproximationPU.h"
+#include "Common/Parallel.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace meshfree
 {
@@ -58,42 +55,41 @@ bool Approximator::PrepareGlobalFit()
     for (int degree = this->Opts.Degree; degree >= 0; --degree)
     {
       const int q = BasisSize(D, D > 0 ? degree : 0);
-      std::vector<double> moment(static_cast<size_t>(q) * q, 0.0);
-      std::vector<double> rhs(static_cast<size_t>(q) * C, 0.0);
-#pragma omp parallel if (nv > 65536)
-      {
-        std::vector<double> m(moment.size(), 0.0), r(rhs.size(), 0.0);
-        constexpr Index block = 256;
-        double xi[3 * block];
-#pragma omp for schedule(static)
-        for (Index b = 0; b < nv; b += block)
-        {
-          const Index e = std::min(nv, b + block);
-          for (Index i = b; i < e; ++i)
+      // The sums over the points, in fixed blocks of points added in block order: the same whatever the number
+      // of threads (one block, as serial as before, up to 65536 points).
+      const size_t qq = static_cast<size_t>(q) * q, size = qq + static_cast<size_t>(q) * C;
+      std::vector<double> sums = ParallelReduce(nv, 65536, std::vector<double>(size, 0.0),
+        [&](Index begin, Index end) {
+          std::vector<double> part(size, 0.0);
+          constexpr Index block = 256;
+          double xi[3 * block];
+          for (Index b = begin; b < end; b += block)
           {
-            const double dx[3] = { sp[3 * i] - this->GlobalOrigin[0], sp[3 * i + 1] - this->GlobalOrigin[1],
-              sp[3 * i + 2] - this->GlobalOrigin[2] };
-            double* x = xi + 3 * (i - b);
-            x[0] = x[1] = x[2] = 0.0;
-            this->Frame.Project<3>(dx, this->GlobalInvScale, x);
+            const Index e = std::min(end, b + block);
+            for (Index i = b; i < e; ++i)
+            {
+              const double dx[3] = { sp[3 * i] - this->GlobalOrigin[0], sp[3 * i + 1] - this->GlobalOrigin[1],
+                sp[3 * i + 2] - this->GlobalOrigin[2] };
+              double* x = xi + 3 * (i - b);
+              x[0] = x[1] = x[2] = 0.0;
+              this->Frame.Project<3>(dx, this->GlobalInvScale, x);
+            }
+            AccumulateFit(D, degree, xi, nullptr, static_cast<int>(e - b), order + b, this->Values.data(), C,
+              part.data(), part.data() + qq);
           }
-          AccumulateFit(D, degree, xi, nullptr, static_cast<int>(e - b), order + b, this->Values.data(), C,
-            m.data(), r.data());
-        }
-#pragma omp critical
-        {
-          for (size_t a = 0; a < m.size(); ++a)
+          return part;
+        },
+        [](std::vector<double> total, const std::vector<double>& part) {
+          for (size_t a = 0; a < part.size(); ++a)
           {
-            moment[a] += m[a];
+            total[a] += part[a];
           }
-          for (size_t a = 0; a < r.size(); ++a)
-          {
-            rhs[a] += r[a];
-          }
-        }
-      }
+          return total;
+        });
+      double* moment = sums.data(); // the moments, then the right-hand sides
+      const double* rhs = sums.data() + qq;
       if (nv >= q &&
-        SolveAccumulatedFit(D, degree, moment.data(), rhs.data(), C, this->Opts.Diagnostics,
+        SolveAccumulatedFit(D, degree, moment, rhs, C, this->Opts.Diagnostics,
           this->GlobalCoefficients.data(), this->GlobalCondition))
       {
         this->GlobalDegree = degree;
@@ -248,12 +244,13 @@ bool Approximator::Evaluate(
     maskFrom(0);
     return false;
   }
-#ifdef _OPENMP
-  const int threads = omp_get_max_threads();
-#else
-  const int threads = 1;
-#endif
-  std::vector<FitScratch> scratch(static_cast<size_t>(threads));
+  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  struct Counts
+  {
+    Index Masked = 0;
+    Index Widened = 0;
+    Index Lowered = 0;
+  };
   const Index blockSize = 16384;
   Index masked = 0, widened = 0, lowered = 0;
   for (Index begin = 0; begin < m; begin += blockSize)
@@ -272,60 +269,69 @@ bool Approximator::Evaluate(
     // A global fit is cheap to evaluate: threads would cost more than they save on small blocks.
     const bool global =
       this->Opts.Method == ApproximationMethod::LS || this->Opts.Method == ApproximationMethod::WLS;
-    const bool parallel = (end - begin) >= (global ? 8192 : 256);
-#pragma omp parallel if (parallel) reduction(+ : masked, widened, lowered)
-    {
-#ifdef _OPENMP
-      FitScratch& s = scratch[static_cast<size_t>(omp_get_thread_num())];
-#else
-      FitScratch& s = scratch[0];
-#endif
-#pragma omp for schedule(dynamic, 64)
-      for (Index i = begin; i < end; ++i)
-      {
-        const double* x = xyz + 3 * i;
-        PointResult r{ false, 0, 0.0, false, false };
-        if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
+    const Counts counts = ParallelReduce(end - begin, global ? 1024 : 64, Counts(),
+      [&](Index b0, Index b1) {
+        FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+        // Each block starts without the previous query's neighbour radius: the warm start may list the same
+        // neighbours in another order, so a block's sums must not depend on which thread ran which block before.
+        s.RadiusGuess = 0.0;
+        Counts mine;
+        for (Index i = begin + b0; i < begin + b1; ++i)
         {
-          switch (this->Opts.Method)
+          const double* x = xyz + 3 * i;
+          PointResult r{ false, 0, 0.0, false, false };
+          if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
           {
-            case ApproximationMethod::LS:
-            case ApproximationMethod::WLS:
-              r = this->GlobalPoint(x, out, i);
-              break;
-            case ApproximationMethod::MLS:
-              r = this->MLSPoint(x, s, out, i);
-              break;
-            case ApproximationMethod::PUWLS:
-              r = this->PUPoint(x, s, out, i);
-              break;
-            case ApproximationMethod::SPH:
-              r = this->SPHPoint(x, s, out, i);
-              break;
+            switch (this->Opts.Method)
+            {
+              case ApproximationMethod::LS:
+              case ApproximationMethod::WLS:
+                r = this->GlobalPoint(x, out, i);
+                break;
+              case ApproximationMethod::MLS:
+                r = this->MLSPoint(x, s, out, i);
+                break;
+              case ApproximationMethod::PUWLS:
+                r = this->PUPoint(x, s, out, i);
+                break;
+              case ApproximationMethod::SPH:
+                r = this->SPHPoint(x, s, out, i);
+                break;
+            }
+          }
+          if (!r.Valid)
+          {
+            this->Mask(out, i);
+            ++mine.Masked;
+            continue;
+          }
+          mine.Widened += r.Widened ? 1 : 0;
+          mine.Lowered += r.Lowered ? 1 : 0;
+          if (out.Valid)
+          {
+            out.Valid[i] = 1;
+          }
+          if (out.NeighborCounts)
+          {
+            out.NeighborCounts[i] = r.Neighbors;
+          }
+          if (out.Conditions)
+          {
+            out.Conditions[i] = std::isfinite(r.Condition) ? r.Condition : 0.0;
           }
         }
-        if (!r.Valid)
-        {
-          this->Mask(out, i);
-          ++masked;
-          continue;
-        }
-        widened += r.Widened ? 1 : 0;
-        lowered += r.Lowered ? 1 : 0;
-        if (out.Valid)
-        {
-          out.Valid[i] = 1;
-        }
-        if (out.NeighborCounts)
-        {
-          out.NeighborCounts[i] = r.Neighbors;
-        }
-        if (out.Conditions)
-        {
-          out.Conditions[i] = std::isfinite(r.Condition) ? r.Condition : 0.0;
-        }
-      }
-    }
+        return mine;
+      },
+      [](Counts a, const Counts& b) {
+        a.Masked += b.Masked;
+        a.Widened += b.Widened;
+        a.Lowered += b.Lowered;
+        return a;
+      },
+      global ? 8192 : 256);
+    masked += counts.Masked;
+    widened += counts.Widened;
+    lowered += counts.Lowered;
   }
   if (progress)
   {

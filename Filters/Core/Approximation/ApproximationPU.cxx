@@ -3,12 +3,10 @@
 // of the centres is documented in Approximation.h.
 #include "Approximation/ApproximationPU.h"
 
+#include "Common/Parallel.h"
+
 #include <algorithm>
 #include <cmath>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace meshfree
 {
@@ -100,11 +98,10 @@ bool Approximator::PreparePU()
   std::vector<double> centers(3 * nodes), supports(nodes), conditions(nodes), coefficients(stride * nodes);
   std::vector<int> degrees(nodes, -1), fitCounts(nodes, 0);
 
-#pragma omp parallel
-  {
-    FitScratch s;
-#pragma omp for schedule(dynamic, 16)
-    for (Index node = 0; node < nodes; ++node)
+  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  ParallelFor(nodes, 16, [&](Index begin, Index end) {
+    FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+    for (Index node = begin; node < end; ++node)
     {
       const Index index[3] = { node % counts[0], (node / counts[0]) % counts[1], node / (counts[0] * counts[1]) };
       double x[3] = { this->CloudCenter[0], this->CloudCenter[1], this->CloudCenter[2] };
@@ -151,7 +148,7 @@ bool Approximator::PreparePU()
         }
       }
     }
-  }
+  });
   Index kept = 0;
   for (Index node = 0; node < nodes; ++node)
   {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // SPH interpolation (thesis 2.3, 5.10): A(x) = sum_j A_j V_j W(|x - x_j|, h), optionally Shepard-normalised.
 #include "Approximation/Approximation.h"
+#include "Common/Parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -42,12 +43,18 @@ bool Approximator::PrepareSPHVolumes()
   const double unitLength = this->SphUnitLength;
   const std::vector<Index>& order = this->Points.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
-#pragma omp parallel
-  {
-    FitScratch s;
-#pragma omp for schedule(dynamic, 256)
-    for (Index p = 0; p < nv; ++p)
+  // Fixed blocks of points, each starting without the previous query's neighbour radius (the warm start may
+  // list the same neighbours in another order): the sums do not depend on which thread ran which block before.
+  constexpr Index block = 256;
+  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  ParallelFor((nv + block - 1) / block, 1, [&](Index b0, Index b1) {
+    FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+    for (Index p = b0 * block; p < std::min(nv, b1 * block); ++p)
     {
+      if (p % block == 0)
+      {
+        s.RadiusGuess = 0.0;
+      }
       const Index id = order[p];
       const double* x = &this->Coordinates[3 * id];
       double h = 1.0;
@@ -61,7 +68,7 @@ bool Approximator::PrepareSPHVolumes()
       const double hd = std::pow(h / unitLength, dim);
       this->SphVolumes[id] = sum > 0.0 ? hd / sum : 0.0;
     }
-  }
+  });
   return true;
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Surface/CloudNormals.h"
 
+#include "Common/Parallel.h"
 #include "Surface/PointSetSurface.h"
 #include "Surface/UniqueCloud.h"
 
@@ -113,39 +114,42 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
   const Index chunk = 65536;
   bool aborted = false;
   Index projected = 0;
+  std::vector<FieldScratch> scratch(fits ? static_cast<size_t>(MaxThreads()) : 0);
   for (Index begin = 0; fits && begin < nv && !aborted; begin += chunk)
   {
     const Index end = std::min(nv, begin + chunk);
-#pragma omp parallel reduction(+ : projected)
-    {
-      FieldScratch scratch;
-#pragma omp for schedule(dynamic, 256)
-      for (Index s = begin; s < end; ++s)
-      {
-        const Index i = order[s];
-        if (!field.Valid[i])
+    projected += ParallelReduce(end - begin, 256, Index(0),
+      [&](Index b0, Index b1) {
+        FieldScratch& fs = scratch[static_cast<size_t>(ThreadIndex())];
+        Index count = 0;
+        for (Index s = begin + b0; s < begin + b1; ++s)
         {
-          continue;
-        }
-        double* x = &result.Points[3 * i];
-        double* normal = &field.Normals[3 * i];
-        if (options.ProjectPoints)
-        {
-          double moved[3] = { x[0], x[1], x[2] }, direction[3];
-          if (surface.Project(moved, direction, median, std::max(1, options.ProjectionIterations), scratch))
+          const Index i = order[s];
+          if (!field.Valid[i])
           {
-            std::copy(moved, moved + 3, x);
-            std::copy(direction, direction + 3, normal);
-            ++projected;
+            continue;
+          }
+          double* x = &result.Points[3 * i];
+          double* normal = &field.Normals[3 * i];
+          if (options.ProjectPoints)
+          {
+            double moved[3] = { x[0], x[1], x[2] }, direction[3];
+            if (surface.Project(moved, direction, median, std::max(1, options.ProjectionIterations), fs))
+            {
+              std::copy(moved, moved + 3, x);
+              std::copy(direction, direction + 3, normal);
+              ++count;
+            }
+          }
+          SphereFit fit;
+          if (options.ComputeCurvature && surface.Fit(x, fit, fs))
+          {
+            result.Curvature[i] = fit.Curvature;
           }
         }
-        SphereFit fit;
-        if (options.ComputeCurvature && surface.Fit(x, fit, scratch))
-        {
-          result.Curvature[i] = fit.Curvature;
-        }
-      }
-    }
+        return count;
+      },
+      [](Index a, Index b) { return a + b; });
     aborted = progress && !progress(0.6 + 0.4 * static_cast<double>(end) / static_cast<double>(nv));
   }
   result.Projected = projected;

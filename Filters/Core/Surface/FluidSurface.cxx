@@ -3,6 +3,7 @@
 // (FluidSurface.h).
 #include "Surface/FluidSurface.h"
 
+#include "Common/Parallel.h"
 #include "Common/Statistics.h"
 
 #include <Eigen/Dense>
@@ -42,17 +43,21 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
   constexpr int k = 20;
   const Index samples = std::min<Index>(nv, 2048);
   std::vector<double> kth(static_cast<size_t>(samples), 0.0);
-#pragma omp parallel
+  // Per-thread query buffers, reused by the three loops below.
+  struct Query
   {
-    std::vector<Index> ids;
-    std::vector<double> d2;
-#pragma omp for schedule(dynamic, 16)
-    for (Index j = 0; j < samples; ++j)
+    std::vector<Index> Ids;
+    std::vector<double> Dist2;
+  };
+  std::vector<Query> queries(static_cast<size_t>(MaxThreads()));
+  ParallelFor(samples, 16, [&](Index begin, Index end) {
+    Query& q = queries[static_cast<size_t>(ThreadIndex())];
+    for (Index j = begin; j < end; ++j)
     {
-      const int found = grid.FindKNearest(sorted + 3 * (j * nv / samples), k + 1, ids, d2);
-      kth[j] = found > 0 ? std::sqrt(d2[found - 1]) : 0.0;
+      const int found = grid.FindKNearest(sorted + 3 * (j * nv / samples), k + 1, q.Ids, q.Dist2);
+      kth[j] = found > 0 ? std::sqrt(q.Dist2[found - 1]) : 0.0;
     }
-  }
+  });
   const double rk = Median(kth);
   const double spacing0 = rk * std::cbrt(4.0 / 3.0 * Pi / (k + 1));
   this->H = options.SupportRadius > 0.0 ? options.SupportRadius : 2.0 * spacing0;
@@ -70,22 +75,19 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
   // 1/H^3 leave double's range, the ratios do not.
   std::vector<double> density(static_cast<size_t>(samples), 0.0);
   const double invH = 1.0 / this->H;
-#pragma omp parallel
-  {
-    std::vector<Index> pos;
-    std::vector<double> d2;
-#pragma omp for schedule(dynamic, 16)
-    for (Index j = 0; j < samples; ++j)
+  ParallelFor(samples, 16, [&](Index begin, Index end) {
+    Query& q = queries[static_cast<size_t>(ThreadIndex())];
+    for (Index j = begin; j < end; ++j)
     {
-      grid.FindWithinRadiusPositions(sorted + 3 * (j * nv / samples), this->H, pos, d2);
+      grid.FindWithinRadiusPositions(sorted + 3 * (j * nv / samples), this->H, q.Ids, q.Dist2);
       double sum = 0.0;
-      for (double r2 : d2)
+      for (double r2 : q.Dist2)
       {
         sum += this->Unit.ValueSquared(r2 * invH * invH);
       }
       density[j] = sum;
     }
-  }
+  });
   const double bulk = Median(density);
   const double v0 = bulk > 0.0 ? 1.0 / bulk : 0.125; // relative to H^3
   this->ParticleSpacing = this->H * std::cbrt(v0);
@@ -113,65 +115,77 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
   const double lambda = std::min(1.0, std::max(0.0, options.Smoothing));
   this->Centres.assign(static_cast<size_t>(3 * nv), 0.0);
   this->Transforms.assign(static_cast<size_t>(9 * nv), 0.0);
-  double largestStretch = 1.0, largestShift = 0.0;
-#pragma omp parallel reduction(max : largestStretch, largestShift)
+  // The largest stretch and shift set the query radius (maxima: exact in any order).
+  struct Extent
   {
-    std::vector<Index> pos;
-    std::vector<double> d2;
-#pragma omp for schedule(dynamic, 256)
-    for (Index s = 0; s < nv; ++s)
-    {
-      const double* x = sorted + 3 * s;
-      grid.FindWithinRadiusPositions(x, reach, pos, d2);
-      double sw = 0.0;
-      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (size_t j = 0; j < pos.size(); ++j)
+    double Stretch = 1.0;
+    double Shift = 0.0;
+  };
+  const Extent largest = ParallelReduce(nv, 256, Extent(),
+    [&](Index begin, Index end) {
+      Query& buffers = queries[static_cast<size_t>(ThreadIndex())];
+      std::vector<Index>& pos = buffers.Ids;
+      std::vector<double>& d2 = buffers.Dist2;
+      Extent mine;
+      for (Index s = begin; s < end; ++s)
       {
-        const double q = std::sqrt(d2[j]) / reach;
-        const double w = 1.0 - q * q * q;
-        const double* p = sorted + 3 * pos[j];
-        mean += w * Eigen::Vector3d(p[0] - x[0], p[1] - x[1], p[2] - x[2]);
-        sw += w;
-      }
-      mean /= sw; // sw >= 1: the particle itself
-      Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
-      for (size_t j = 0; j < pos.size(); ++j)
-      {
-        const double q = std::sqrt(d2[j]) / reach;
-        const double w = 1.0 - q * q * q;
-        const double* p = sorted + 3 * pos[j];
-        const Eigen::Vector3d d = Eigen::Vector3d(p[0] - x[0], p[1] - x[1], p[2] - x[2]) - mean;
-        C.noalias() += w * d * d.transpose();
-      }
-      C /= sw;
-      Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
-      if (static_cast<int>(pos.size()) >= options.MinimumNeighbors)
-      {
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-        eig.computeDirect(C);
-        Eigen::Vector3d sigma = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt(); // ascending
-        const double top = sigma(2);
-        if (top > 0.0 && std::isfinite(top))
+        const double* x = sorted + 3 * s;
+        grid.FindWithinRadiusPositions(x, reach, pos, d2);
+        double sw = 0.0;
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (size_t j = 0; j < pos.size(); ++j)
         {
-          sigma = sigma.cwiseMax(top / ratio);
-          // Stretches of unit product: the kernel keeps the isotropic kernel's volume.
-          const Eigen::Vector3d stretch = sigma / std::cbrt(sigma(0) * sigma(1) * sigma(2));
-          M = eig.eigenvectors() * stretch.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
-          largestStretch = std::max(largestStretch, stretch.maxCoeff());
+          const double q = std::sqrt(d2[j]) / reach;
+          const double w = 1.0 - q * q * q;
+          const double* p = sorted + 3 * pos[j];
+          mean += w * Eigen::Vector3d(p[0] - x[0], p[1] - x[1], p[2] - x[2]);
+          sw += w;
         }
-      }
-      for (int a = 0; a < 3; ++a)
-      {
-        this->Centres[3 * s + a] = x[a] + lambda * mean(a);
-        for (int b = 0; b < 3; ++b)
+        mean /= sw; // sw >= 1: the particle itself
+        Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+        for (size_t j = 0; j < pos.size(); ++j)
         {
-          this->Transforms[9 * s + 3 * a + b] = M(a, b);
+          const double q = std::sqrt(d2[j]) / reach;
+          const double w = 1.0 - q * q * q;
+          const double* p = sorted + 3 * pos[j];
+          const Eigen::Vector3d d = Eigen::Vector3d(p[0] - x[0], p[1] - x[1], p[2] - x[2]) - mean;
+          C.noalias() += w * d * d.transpose();
         }
+        C /= sw;
+        Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
+        if (static_cast<int>(pos.size()) >= options.MinimumNeighbors)
+        {
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+          eig.computeDirect(C);
+          Eigen::Vector3d sigma = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt(); // ascending
+          const double top = sigma(2);
+          if (top > 0.0 && std::isfinite(top))
+          {
+            sigma = sigma.cwiseMax(top / ratio);
+            // Stretches of unit product: the kernel keeps the isotropic kernel's volume.
+            const Eigen::Vector3d stretch = sigma / std::cbrt(sigma(0) * sigma(1) * sigma(2));
+            M = eig.eigenvectors() * stretch.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+            mine.Stretch = std::max(mine.Stretch, stretch.maxCoeff());
+          }
+        }
+        for (int a = 0; a < 3; ++a)
+        {
+          this->Centres[3 * s + a] = x[a] + lambda * mean(a);
+          for (int b = 0; b < 3; ++b)
+          {
+            this->Transforms[9 * s + 3 * a + b] = M(a, b);
+          }
+        }
+        mine.Shift = std::max(mine.Shift, lambda * mean.norm());
       }
-      largestShift = std::max(largestShift, lambda * mean.norm());
-    }
-  }
-  this->QueryRadius = this->H * largestStretch + largestShift;
+      return mine;
+    },
+    [](Extent a, const Extent& b) {
+      a.Stretch = std::max(a.Stretch, b.Stretch);
+      a.Shift = std::max(a.Shift, b.Shift);
+      return a;
+    });
+  this->QueryRadius = this->H * largest.Stretch + largest.Shift;
   return true;
 }
 

@@ -3,6 +3,7 @@
 #include "Surface/PatchSurface.h"
 
 #include "Common/LocalFit.h"
+#include "Common/Parallel.h"
 
 #include <Eigen/Dense>
 
@@ -170,12 +171,19 @@ void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, con
   // One height fit per patch over the points within rho.
   std::vector<double> heights(static_cast<size_t>(6 * candidates), 0.0);
   std::vector<unsigned char> kept(static_cast<size_t>(candidates), 0);
-#pragma omp parallel
+  struct Buffers
   {
-    std::vector<Index> pos;
-    std::vector<double> d2, uvh, w;
-#pragma omp for schedule(dynamic, 64)
-    for (Index p = 0; p < candidates; ++p)
+    std::vector<Index> Positions;
+    std::vector<double> Dist2, UVH, Weights;
+  };
+  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
+  ParallelFor(candidates, 64, [&](Index begin, Index end) {
+    Buffers& mine = buffers[static_cast<size_t>(ThreadIndex())];
+    std::vector<Index>& pos = mine.Positions;
+    std::vector<double>& d2 = mine.Dist2;
+    std::vector<double>& uvh = mine.UVH;
+    std::vector<double>& w = mine.Weights;
+    for (Index p = begin; p < end; ++p)
     {
       const double* c = &centres[3 * p];
       double* f = &frames[9 * p];
@@ -236,7 +244,7 @@ void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, con
       }
       kept[p] = ok ? 1 : 0;
     }
-  }
+  });
   for (Index p = 0; p < candidates; ++p)
   {
     if (!kept[p])

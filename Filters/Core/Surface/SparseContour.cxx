@@ -2,14 +2,12 @@
 // Sparse continuation contouring; the method is described in SparseContour.h.
 #include "Surface/SparseContour.h"
 
+#include "Common/Parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <deque>
 #include <unordered_map>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace meshfree
 {
@@ -412,36 +410,48 @@ bool EvaluatePending(Lattice& lattice, const ImplicitField& field, ContourReport
   std::sort(pending.begin(), pending.end());
   const Index count = static_cast<Index>(pending.size());
   constexpr Index Chunk = 512;
+  struct Counts
+  {
+    Index Evaluated = 0;
+    Index Undefined = 0;
+  };
+  std::vector<FieldScratch> scratch(static_cast<size_t>(MaxThreads()));
   for (Index begin = 0; begin < count; begin += Chunk)
   {
     const Index end = std::min(count, begin + Chunk);
-    Index evaluated = 0, undefined = 0;
-#pragma omp parallel reduction(+ : evaluated, undefined)
-    {
-      FieldScratch scratch;
-#pragma omp for schedule(dynamic, 1)
-      for (Index p = begin; p < end; ++p)
-      {
-        Block& b = lattice.Blocks[pending[p]];
-        b.Pending = false;
-        for (int c = 0; c < BlockCorners; ++c)
+    // Ranges of one lattice block (up to 512 corners to evaluate).
+    const Counts counts = ParallelReduce(end - begin, 1, Counts(),
+      [&](Index b0, Index b1) {
+        FieldScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+        Counts mine;
+        for (Index p = begin + b0; p < begin + b1; ++p)
         {
-          if (b.State[c] != Requested)
+          Block& b = lattice.Blocks[pending[p]];
+          b.Pending = false;
+          for (int c = 0; c < BlockCorners; ++c)
           {
-            continue;
+            if (b.State[c] != Requested)
+            {
+              continue;
+            }
+            double x[3], f = 0.0;
+            lattice.CornerPosition(b, c, x);
+            const bool ok = field.Evaluate(x, f, nullptr, s) && std::isfinite(f);
+            b.Value[c] = ok ? f : 0.0;
+            b.State[c] = ok ? Defined : Undefined;
+            ++mine.Evaluated;
+            mine.Undefined += ok ? 0 : 1;
           }
-          double x[3], f = 0.0;
-          lattice.CornerPosition(b, c, x);
-          const bool ok = field.Evaluate(x, f, nullptr, scratch) && std::isfinite(f);
-          b.Value[c] = ok ? f : 0.0;
-          b.State[c] = ok ? Defined : Undefined;
-          ++evaluated;
-          undefined += ok ? 0 : 1;
         }
-      }
-    }
-    report.EvaluatedCorners += evaluated;
-    report.UndefinedCorners += undefined;
+        return mine;
+      },
+      [](Counts a, const Counts& b) {
+        a.Evaluated += b.Evaluated;
+        a.Undefined += b.Undefined;
+        return a;
+      });
+    report.EvaluatedCorners += counts.Evaluated;
+    report.UndefinedCorners += counts.Undefined;
     if (progress && !progress(fraction))
     {
       return false;
@@ -453,15 +463,15 @@ bool EvaluatePending(Lattice& lattice, const ImplicitField& field, ContourReport
 /// The cells beyond the crossed faces of `cells` that are not active yet (sorted, unique).
 std::vector<std::uint64_t> GrowthFront(const Lattice& lattice, const std::vector<std::uint64_t>& cells, bool& edge)
 {
-  std::vector<std::uint64_t> front;
-  bool reachedEdge = false;
   const Index count = static_cast<Index>(cells.size());
-#pragma omp parallel
-  {
-    std::vector<std::uint64_t> mine;
-    bool mineEdge = false;
-#pragma omp for schedule(dynamic, 1024) nowait
-    for (Index n = 0; n < count; ++n)
+  // Each thread collects its own cells; their union is sorted below, so the order of the ranges is irrelevant.
+  const size_t threads = static_cast<size_t>(MaxThreads());
+  std::vector<std::vector<std::uint64_t>> found(threads);
+  std::vector<unsigned char> reachedEdge(threads, 0);
+  ParallelFor(count, 1024, [&](Index begin, Index end) {
+    const size_t t = static_cast<size_t>(ThreadIndex());
+    std::vector<std::uint64_t>& mine = found[t];
+    for (Index n = begin; n < end; ++n)
     {
       Index c[3];
       UnpackCell(cells[n], c);
@@ -486,7 +496,7 @@ std::vector<std::uint64_t> GrowthFront(const Lattice& lattice, const std::vector
         d[axis] += (f % 2) ? 1 : -1;
         if (d[axis] < 0 || d[axis] + 1 > SparseContour::kMaximumCoordinate)
         {
-          mineEdge = true;
+          reachedEdge[t] = 1;
           continue;
         }
         if (!lattice.IsActive(d[0], d[1], d[2]))
@@ -495,15 +505,22 @@ std::vector<std::uint64_t> GrowthFront(const Lattice& lattice, const std::vector
         }
       }
     }
-#pragma omp critical
-    {
-      front.insert(front.end(), mine.begin(), mine.end());
-      reachedEdge = reachedEdge || mineEdge;
-    }
+  });
+  std::vector<std::uint64_t> front;
+  size_t total = 0;
+  for (const auto& mine : found)
+  {
+    total += mine.size();
+  }
+  front.reserve(total);
+  for (size_t t = 0; t < threads; ++t)
+  {
+    front.insert(front.end(), found[t].begin(), found[t].end());
+    std::vector<std::uint64_t>().swap(found[t]);
+    edge = edge || reachedEdge[t];
   }
   std::sort(front.begin(), front.end());
   front.erase(std::unique(front.begin(), front.end()), front.end());
-  edge = edge || reachedEdge;
   return front;
 }
 } // namespace
@@ -578,29 +595,30 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
   const Index nb = static_cast<Index>(lattice.Blocks.size());
   const double cell = options.CellSize;
   const double clamp = std::min(0.5, std::max(0.0, options.ClampFraction));
-#pragma omp parallel for schedule(dynamic, 16)
-  for (Index bi = 0; bi < nb; ++bi)
-  {
-    Block& b = lattice.Blocks[bi];
-    b.EdgeCodes.clear();
-    for (int c = 0; c < BlockCorners; ++c)
+  ParallelFor(nb, 16, [&](Index begin, Index end) {
+    for (Index bi = begin; bi < end; ++bi)
     {
-      if (b.State[c] != Defined)
+      Block& b = lattice.Blocks[bi];
+      b.EdgeCodes.clear();
+      for (int c = 0; c < BlockCorners; ++c)
       {
-        continue;
-      }
-      const int li = c & 7, lj = (c >> 3) & 7, lk = c >> 6;
-      for (int axis = 0; axis < 3; ++axis)
-      {
-        int local = 0;
-        const Block* o = lattice.Offset(b, li, lj, lk, 1 << axis, local);
-        if (o && o->State[local] == Defined && ((b.Value[c] < 0.0) != (o->Value[local] < 0.0)))
+        if (b.State[c] != Defined)
         {
-          b.EdgeCodes.push_back(static_cast<std::uint16_t>(3 * c + axis));
+          continue;
+        }
+        const int li = c & 7, lj = (c >> 3) & 7, lk = c >> 6;
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          int local = 0;
+          const Block* o = lattice.Offset(b, li, lj, lk, 1 << axis, local);
+          if (o && o->State[local] == Defined && ((b.Value[c] < 0.0) != (o->Value[local] < 0.0)))
+          {
+            b.EdgeCodes.push_back(static_cast<std::uint16_t>(3 * c + axis));
+          }
         }
       }
     }
-  }
+  });
   Index vertices = 0;
   for (Block& b : lattice.Blocks)
   {
@@ -608,23 +626,24 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
     vertices += static_cast<Index>(b.EdgeCodes.size());
   }
   std::vector<double> points(static_cast<size_t>(3 * vertices));
-#pragma omp parallel for schedule(dynamic, 16)
-  for (Index bi = 0; bi < nb; ++bi)
-  {
-    const Block& b = lattice.Blocks[bi];
-    for (size_t n = 0; n < b.EdgeCodes.size(); ++n)
+  ParallelFor(nb, 16, [&](Index begin, Index end) {
+    for (Index bi = begin; bi < end; ++bi)
     {
-      const int c = b.EdgeCodes[n] / 3, axis = b.EdgeCodes[n] % 3;
-      int local = 0;
-      const Block* o = lattice.Offset(b, c & 7, (c >> 3) & 7, c >> 6, 1 << axis, local);
-      const double f0 = b.Value[c], f1 = o->Value[local];
-      double t = f0 / (f0 - f1);
-      t = std::min(1.0 - clamp, std::max(clamp, t));
-      double* x = &points[3 * (b.VertexBase + static_cast<Index>(n))];
-      lattice.CornerPosition(b, c, x);
-      x[axis] += t * cell;
+      const Block& b = lattice.Blocks[bi];
+      for (size_t n = 0; n < b.EdgeCodes.size(); ++n)
+      {
+        const int c = b.EdgeCodes[n] / 3, axis = b.EdgeCodes[n] % 3;
+        int local = 0;
+        const Block* o = lattice.Offset(b, c & 7, (c >> 3) & 7, c >> 6, 1 << axis, local);
+        const double f0 = b.Value[c], f1 = o->Value[local];
+        double t = f0 / (f0 - f1);
+        t = std::min(1.0 - clamp, std::max(clamp, t));
+        double* x = &points[3 * (b.VertexBase + static_cast<Index>(n))];
+        lattice.CornerPosition(b, c, x);
+        x[axis] += t * cell;
+      }
     }
-  }
+  });
   if (progress && !progress(0.9))
   {
     report.Aborted = true;
@@ -635,93 +654,94 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
   // the cell's block, referred to as -(1 + their index in the block) until all blocks are done.
   std::vector<std::vector<Index>> blockTriangles(static_cast<size_t>(nb));
   std::vector<std::vector<double>> blockCentres(static_cast<size_t>(nb));
-#pragma omp parallel for schedule(dynamic, 16)
-  for (Index bi = 0; bi < nb; ++bi)
-  {
-    const Block& b = lattice.Blocks[bi];
-    std::vector<Index>& out = blockTriangles[bi];
-    std::vector<double>& centres = blockCentres[bi];
-    for (int w = 0; w < BlockCorners / 64; ++w)
+  ParallelFor(nb, 16, [&](Index begin, Index end) {
+    for (Index bi = begin; bi < end; ++bi)
     {
-      for (std::uint64_t bits = b.Active[w]; bits; bits &= bits - 1)
+      const Block& b = lattice.Blocks[bi];
+      std::vector<Index>& out = blockTriangles[bi];
+      std::vector<double>& centres = blockCentres[bi];
+      for (int w = 0; w < BlockCorners / 64; ++w)
       {
-        const int c = 64 * w + __builtin_ctzll(bits);
-        const int li = c & 7, lj = (c >> 3) & 7, lk = c >> 6;
-        double v[8];
-        const Block* owner[8];
-        int local[8];
-        bool complete = true;
-        int negatives = 0;
-        for (int q = 0; q < 8 && complete; ++q)
+        for (std::uint64_t bits = b.Active[w]; bits; bits &= bits - 1)
         {
-          owner[q] = lattice.Offset(b, li, lj, lk, q, local[q]);
-          complete = owner[q] && owner[q]->State[local[q]] == Defined;
-          if (complete)
+          const int c = 64 * w + __builtin_ctzll(bits);
+          const int li = c & 7, lj = (c >> 3) & 7, lk = c >> 6;
+          double v[8];
+          const Block* owner[8];
+          int local[8];
+          bool complete = true;
+          int negatives = 0;
+          for (int q = 0; q < 8 && complete; ++q)
           {
-            v[q] = owner[q]->Value[local[q]];
-            negatives += v[q] < 0.0 ? 1 : 0;
+            owner[q] = lattice.Offset(b, li, lj, lk, q, local[q]);
+            complete = owner[q] && owner[q]->State[local[q]] == Defined;
+            if (complete)
+            {
+              v[q] = owner[q]->Value[local[q]];
+              negatives += v[q] < 0.0 ? 1 : 0;
+            }
           }
-        }
-        if (!complete || negatives == 0 || negatives == 8)
-        {
-          continue;
-        }
-        CellPolygons polygons;
-        PolygonizeCell(v, polygons);
-        Index edgeVertex[12];
-        bool found = true;
-        for (int l = 0; l < polygons.LoopCount && found; ++l)
-        {
-          for (int m = 0; m < polygons.LoopLength[l] && found; ++m)
+          if (!complete || negatives == 0 || negatives == 8)
           {
-            const int e = polygons.LoopEdges[l][m];
-            int lower = 0, upper = 0;
-            CellEdgeCorners(e, lower, upper);
-            const Block* o = owner[lower];
-            const std::uint16_t code = static_cast<std::uint16_t>(3 * local[lower] + e / 4);
-            const auto it = std::lower_bound(o->EdgeCodes.begin(), o->EdgeCodes.end(), code);
-            found = it != o->EdgeCodes.end() && *it == code;
-            edgeVertex[e] = found ? o->VertexBase + static_cast<Index>(it - o->EdgeCodes.begin()) : -1;
-          }
-        }
-        if (!found)
-        {
-          continue; // cannot happen: both corners of every crossing edge are defined
-        }
-        Index centre[4] = { 0, 0, 0, 0 };
-        bool centred[4] = { false, false, false, false };
-        for (int t = 0; t < 3 * polygons.TriangleCount; ++t)
-        {
-          const int code = polygons.Triangles[t];
-          if (code < CellPolygons::LoopCentre)
-          {
-            out.push_back(edgeVertex[code]);
             continue;
           }
-          const int l = code - CellPolygons::LoopCentre;
-          if (!centred[l])
+          CellPolygons polygons;
+          PolygonizeCell(v, polygons);
+          Index edgeVertex[12];
+          bool found = true;
+          for (int l = 0; l < polygons.LoopCount && found; ++l)
           {
-            double sum[3] = { 0.0, 0.0, 0.0 };
-            for (int m = 0; m < polygons.LoopLength[l]; ++m)
+            for (int m = 0; m < polygons.LoopLength[l] && found; ++m)
             {
-              const double* x = &points[3 * edgeVertex[polygons.LoopEdges[l][m]]];
+              const int e = polygons.LoopEdges[l][m];
+              int lower = 0, upper = 0;
+              CellEdgeCorners(e, lower, upper);
+              const Block* o = owner[lower];
+              const std::uint16_t code = static_cast<std::uint16_t>(3 * local[lower] + e / 4);
+              const auto it = std::lower_bound(o->EdgeCodes.begin(), o->EdgeCodes.end(), code);
+              found = it != o->EdgeCodes.end() && *it == code;
+              edgeVertex[e] = found ? o->VertexBase + static_cast<Index>(it - o->EdgeCodes.begin()) : -1;
+            }
+          }
+          if (!found)
+          {
+            continue; // cannot happen: both corners of every crossing edge are defined
+          }
+          Index centre[4] = { 0, 0, 0, 0 };
+          bool centred[4] = { false, false, false, false };
+          for (int t = 0; t < 3 * polygons.TriangleCount; ++t)
+          {
+            const int code = polygons.Triangles[t];
+            if (code < CellPolygons::LoopCentre)
+            {
+              out.push_back(edgeVertex[code]);
+              continue;
+            }
+            const int l = code - CellPolygons::LoopCentre;
+            if (!centred[l])
+            {
+              double sum[3] = { 0.0, 0.0, 0.0 };
+              for (int m = 0; m < polygons.LoopLength[l]; ++m)
+              {
+                const double* x = &points[3 * edgeVertex[polygons.LoopEdges[l][m]]];
+                for (int a = 0; a < 3; ++a)
+                {
+                  sum[a] += x[a];
+                }
+              }
               for (int a = 0; a < 3; ++a)
               {
-                sum[a] += x[a];
+                centres.push_back(sum[a] / polygons.LoopLength[l]);
               }
+              centre[l] = -static_cast<Index>(centres.size() / 3);
+              centred[l] = true;
             }
-            for (int a = 0; a < 3; ++a)
-            {
-              centres.push_back(sum[a] / polygons.LoopLength[l]);
-            }
-            centre[l] = -static_cast<Index>(centres.size() / 3);
-            centred[l] = true;
+            out.push_back(centre[l]);
           }
-          out.push_back(centre[l]);
         }
       }
     }
-  }
+  });
   Index centreBase = vertices;
   for (Index bi = 0; bi < nb; ++bi)
   {

@@ -3,6 +3,7 @@
 #include "Surface/SurfaceNormals.h"
 
 #include "Common/LocalFit.h"
+#include "Common/Parallel.h"
 #include "Common/Statistics.h"
 
 #include <Eigen/Dense>
@@ -272,13 +273,19 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
   const double* sorted = grid.SortedPoints();
   std::vector<double> kth(static_cast<size_t>(samples), 0.0);
   std::vector<double> spread(static_cast<size_t>(samples), 0.0);
-#pragma omp parallel
+  // Per-thread query buffers of both loops below.
+  struct Buffers
   {
-    std::vector<Index> ids;
-    std::vector<double> d2;
-    std::vector<Index> pos;
-#pragma omp for schedule(dynamic, 16)
-    for (Index j = 0; j < samples; ++j)
+    std::vector<Index> Ids, Positions;
+    std::vector<double> Dist2;
+  };
+  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
+  ParallelFor(samples, 16, [&](Index begin, Index end) {
+    Buffers& mine = buffers[static_cast<size_t>(ThreadIndex())];
+    std::vector<Index>& ids = mine.Ids;
+    std::vector<double>& d2 = mine.Dist2;
+    std::vector<Index>& pos = mine.Positions;
+    for (Index j = begin; j < end; ++j)
     {
       const Index s = j * nv / samples;
       const double* x = sorted + 3 * s;
@@ -292,7 +299,7 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
       const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, kth[j], false);
       spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
     }
-  }
+  });
   const double rk = Median(kth);
   scale.Spacing = rk * std::sqrt(Pi / k);
   scale.Noise = Median(spread);
@@ -304,19 +311,17 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
   double radius = std::max(rk, NoiseRadius(scale.Noise, scale.Spacing, options.TiltTolerance));
   for (int round = 0; round < 3 && radius > rk; ++round)
   {
-#pragma omp parallel
-    {
-      std::vector<Index> pos;
-      std::vector<double> d2;
-#pragma omp for schedule(dynamic, 16)
-      for (Index j = 0; j < samples; ++j)
+    ParallelFor(samples, 16, [&](Index begin, Index end) {
+      std::vector<Index>& pos = buffers[static_cast<size_t>(ThreadIndex())].Positions;
+      std::vector<double>& d2 = buffers[static_cast<size_t>(ThreadIndex())].Dist2;
+      for (Index j = begin; j < end; ++j)
       {
         const double* x = sorted + 3 * (j * nv / samples);
         grid.FindWithinRadiusPositions(x, radius, pos, d2);
         const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius, false);
         spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
       }
-    }
+    });
     scale.Noise = Median(spread);
     const double next = std::max(rk, NoiseRadius(scale.Noise, scale.Spacing, options.TiltTolerance));
     const bool settled = std::fabs(next - radius) < 0.05 * radius;
@@ -369,82 +374,92 @@ bool EstimateNormals(
   const Index chunk = 65536;
   Index invalid = n - nv;
   bool aborted = false;
+  struct Buffers
+  {
+    std::vector<Index> Ids, Positions;
+    std::vector<double> Dist2, Radius2, Keys;
+  };
+  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
   for (Index begin = 0; begin < nv && !aborted; begin += chunk)
   {
     const Index end = std::min(nv, begin + chunk);
-    Index bad = 0;
-#pragma omp parallel reduction(+ : bad)
-    {
-      std::vector<Index> ids, pos;
-      std::vector<double> d2, r2;
-      std::vector<double> keys;
-#pragma omp for schedule(dynamic, 256)
-      for (Index s = begin; s < end; ++s)
-      {
-        const Index id = order[s];
-        const double* x = sorted + 3 * s;
-        std::int32_t* row = &field.Graph[static_cast<size_t>(id) * degree];
-        // Where the noise (or density) radius holds more than k neighbours, the k nearest are among them: one
-        // radius query gives the neighbourhood, r_k and the orientation graph. Otherwise a k-nearest query.
-        const double first = fixed ? options.SupportRadius : noiseRadius > 0.0 ? noiseRadius : densityRadius;
-        if (first > 0.0)
+    const Index bad = ParallelReduce(end - begin, 256, Index(0),
+      [&](Index b0, Index b1) {
+        Buffers& mine = buffers[static_cast<size_t>(ThreadIndex())];
+        std::vector<Index>& ids = mine.Ids;
+        std::vector<Index>& pos = mine.Positions;
+        std::vector<double>& d2 = mine.Dist2;
+        std::vector<double>& r2 = mine.Radius2;
+        std::vector<double>& keys = mine.Keys;
+        Index failed = 0;
+        for (Index s = begin + b0; s < begin + b1; ++s)
         {
-          grid.FindWithinRadiusPositions(x, first, pos, r2);
-        }
-        double radius = first;
-        if (!(first > 0.0 && NearestOfList(pos, r2, k, order, row, degree, field.NeighborDistance[id], keys)))
-        {
-          const int found = NearestDistinct(grid, x, k, ids, d2, field.NeighborDistance[id]);
-          int kept = 0;
-          for (int j = 0; j < found && kept < degree; ++j)
+          const Index id = order[s];
+          const double* x = sorted + 3 * s;
+          std::int32_t* row = &field.Graph[static_cast<size_t>(id) * degree];
+          // Where the noise (or density) radius holds more than k neighbours, the k nearest are among them: one
+          // radius query gives the neighbourhood, r_k and the orientation graph. Otherwise a k-nearest query.
+          const double first = fixed ? options.SupportRadius : noiseRadius > 0.0 ? noiseRadius : densityRadius;
+          if (first > 0.0)
           {
-            if (d2[j] > 0.0)
+            grid.FindWithinRadiusPositions(x, first, pos, r2);
+          }
+          double radius = first;
+          if (!(first > 0.0 && NearestOfList(pos, r2, k, order, row, degree, field.NeighborDistance[id], keys)))
+          {
+            const int found = NearestDistinct(grid, x, k, ids, d2, field.NeighborDistance[id]);
+            int kept = 0;
+            for (int j = 0; j < found && kept < degree; ++j)
             {
-              row[kept++] = static_cast<std::int32_t>(ids[j]);
+              if (d2[j] > 0.0)
+              {
+                row[kept++] = static_cast<std::int32_t>(ids[j]);
+              }
+            }
+            if (!fixed)
+            {
+              radius = std::max(field.NeighborDistance[id], noiseRadius);
+              grid.FindWithinRadiusPositions(x, radius, pos, r2);
             }
           }
-          if (!fixed)
+          else if (densityRadius > 0.0)
           {
-            radius = std::max(field.NeighborDistance[id], noiseRadius);
-            grid.FindWithinRadiusPositions(x, radius, pos, r2);
-          }
-        }
-        else if (densityRadius > 0.0)
-        {
-          // The neighbourhood is the points within r_k, as a query at r_k would give them.
-          radius = field.NeighborDistance[id];
-          const double cut = radius * radius;
-          size_t kept = 0;
-          for (size_t j = 0; j < pos.size(); ++j)
-          {
-            if (r2[j] <= cut)
+            // The neighbourhood is the points within r_k, as a query at r_k would give them.
+            radius = field.NeighborDistance[id];
+            const double cut = radius * radius;
+            size_t kept = 0;
+            for (size_t j = 0; j < pos.size(); ++j)
             {
-              pos[kept] = pos[j];
-              r2[kept++] = r2[j];
+              if (r2[j] <= cut)
+              {
+                pos[kept] = pos[j];
+                r2[kept++] = r2[j];
+              }
             }
+            pos.resize(kept);
+            r2.resize(kept);
           }
-          pos.resize(kept);
-          r2.resize(kept);
+          // Where the noise sets the radius, the quadric's exactness is below the noise's tilt: PCA suffices.
+          const bool jet = fixed || !(noiseRadius > field.NeighborDistance[id]);
+          const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius, jet);
+          if (!pca.Valid)
+          {
+            ++failed;
+            continue;
+          }
+          for (int a = 0; a < 3; ++a)
+          {
+            field.Normals[3 * id + a] = pca.Normal[a];
+          }
+          field.Residual[id] = pca.Residual;
+          const double total = pca.Eigenvalues[0] + pca.Eigenvalues[1] + pca.Eigenvalues[2];
+          field.SurfaceVariation[id] = total > 0.0 ? pca.Eigenvalues[0] / total : 0.0;
+          field.Radii[id] = radius;
+          field.Valid[id] = 1;
         }
-        // Where the noise sets the radius, the quadric's exactness is below the noise's tilt: PCA suffices.
-        const bool jet = fixed || !(noiseRadius > field.NeighborDistance[id]);
-        const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius, jet);
-        if (!pca.Valid)
-        {
-          ++bad;
-          continue;
-        }
-        for (int a = 0; a < 3; ++a)
-        {
-          field.Normals[3 * id + a] = pca.Normal[a];
-        }
-        field.Residual[id] = pca.Residual;
-        const double total = pca.Eigenvalues[0] + pca.Eigenvalues[1] + pca.Eigenvalues[2];
-        field.SurfaceVariation[id] = total > 0.0 ? pca.Eigenvalues[0] / total : 0.0;
-        field.Radii[id] = radius;
-        field.Valid[id] = 1;
-      }
-    }
+        return failed;
+      },
+      [](Index a, Index b) { return a + b; });
     invalid += bad;
     aborted = progress && !progress(static_cast<double>(end) / static_cast<double>(nv));
   }

@@ -2,6 +2,7 @@
 // The surface-reconstruction driver (SurfaceReconstruction.h): validate, scales, field, contour, project.
 #include "Surface/SurfaceReconstruction.h"
 
+#include "Common/Parallel.h"
 #include "Surface/FluidSurface.h"
 #include "Surface/PatchSurface.h"
 #include "Surface/PointSetSurface.h"
@@ -136,11 +137,10 @@ std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitFie
   const Index count = static_cast<Index>(blocks.size());
   std::vector<std::uint64_t> seeds(static_cast<size_t>(count), 0);
   std::vector<unsigned char> ok(static_cast<size_t>(count), 0);
-#pragma omp parallel
-  {
-    FieldScratch scratch;
-#pragma omp for schedule(dynamic, 64)
-    for (Index b = 0; b < count; ++b)
+  std::vector<FieldScratch> scratches(static_cast<size_t>(MaxThreads()));
+  ParallelFor(count, 64, [&](Index begin, Index end) {
+    FieldScratch& scratch = scratches[static_cast<size_t>(ThreadIndex())];
+    for (Index b = begin; b < end; ++b)
     {
       double x[3], n[3];
       const double* p = sorted + 3 * blocks[b].second;
@@ -165,7 +165,7 @@ std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitFie
         ok[b] = 1;
       }
     }
-  }
+  });
   std::vector<std::uint64_t> kept;
   kept.reserve(seeds.size());
   for (Index b = 0; b < count; ++b)
@@ -185,36 +185,38 @@ Index ProjectVertices(const ImplicitField& field, double maxStep, bool project, 
   const Index nv = mesh.NumberOfPoints();
   mesh.Normals.assign(static_cast<size_t>(3 * nv), 0.0);
   std::vector<unsigned char> done(static_cast<size_t>(nv), 0);
-  Index projected = 0;
-#pragma omp parallel reduction(+ : projected)
-  {
-    FieldScratch scratch;
-#pragma omp for schedule(dynamic, 512)
-    for (Index v = 0; v < nv; ++v)
-    {
-      double* x = &mesh.Points[3 * v];
-      double* n = &mesh.Normals[3 * v];
-      if (project)
+  std::vector<FieldScratch> scratches(static_cast<size_t>(MaxThreads()));
+  const Index projected = ParallelReduce(nv, 512, Index(0),
+    [&](Index begin, Index end) {
+      FieldScratch& scratch = scratches[static_cast<size_t>(ThreadIndex())];
+      Index count = 0;
+      for (Index v = begin; v < end; ++v)
       {
-        if (field.Project(x, n, maxStep, 1, scratch))
+        double* x = &mesh.Points[3 * v];
+        double* n = &mesh.Normals[3 * v];
+        if (project)
         {
+          if (field.Project(x, n, maxStep, 1, scratch))
+          {
+            done[v] = 1;
+            ++count;
+          }
+          continue;
+        }
+        double f = 0.0, g[3];
+        const double len = field.Evaluate(x, f, g, scratch) ? std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) : 0.0;
+        if (len > 0.0 && std::isfinite(len))
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            n[a] = g[a] / len;
+          }
           done[v] = 1;
-          ++projected;
         }
-        continue;
       }
-      double f = 0.0, g[3];
-      const double len = field.Evaluate(x, f, g, scratch) ? std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) : 0.0;
-      if (len > 0.0 && std::isfinite(len))
-      {
-        for (int a = 0; a < 3; ++a)
-        {
-          n[a] = g[a] / len;
-        }
-        done[v] = 1;
-      }
-    }
-  }
+      return count;
+    },
+    [](Index a, Index b) { return a + b; });
   // Triangle normals (area-weighted) for the rest.
   const Index nt = mesh.NumberOfTriangles();
   bool any = false;
