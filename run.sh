@@ -52,7 +52,7 @@ case "${1:-}" in
     out="$build/demo"
     mkdir -p "$out"
     echo "== running the demo; pictures go to $out"
-    export MESHFREE_PLUGIN="$build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so" OMP_WAIT_POLICY=passive
+    export MESHFREE_PLUGIN="$build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so"
     # Kernels and neighbour grid; thesis figures 3.1-3.5 (approximation), 4.6-4.8 (deformable solids) and
     # 5.8 (SPH dam break) rebuilt from Data/; the deformable scenes; a 3D dam break of 65,536 particles.
     # One X server for all scripts (starting one per script races with other Xvfb users on busy machines).

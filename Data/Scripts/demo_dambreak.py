@@ -17,7 +17,6 @@ from demo_common import load_plugin, new_view
 
 def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
     """Render the dam break into out/dambreak_NNN.png; returns the list of paths."""
-    os.environ.setdefault("OMP_WAIT_POLICY", "passive")
     if "SPHFluid" not in globals():
         load_plugin(globals())  # puts the plugin's proxies (SPHFluid) into this module's namespace
     domain = [0.0, 1.6, 0.0, 0.32, 0.0, 0.5]

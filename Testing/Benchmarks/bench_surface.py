@@ -24,7 +24,7 @@ SPH particles (jittered cubic lattice, spacing H known): a ball and a resting bl
 Cases, each in its own process through /usr/bin/time -v (wall seconds, peak resident memory); the environment is
 the caller's without any OMP_* variable (every tool on its default threads), plus VTK_SMP_BACKEND_IN_USE=
 STDThread unless set, plus --set-env's (e.g. OMP_WAIT_POLICY=passive: on a busy 2-core machine OpenMP's spinning
-barriers slow Open3D and MeshFree several-fold); the 1-minute load average is recorded before every run:
+barriers slow Open3D several-fold); the 1-minute load average is recorded before every run:
   normals   positions only -> oriented normals: MeshFree MeshlessNormals (ComputeCurvature 0, as the peers, and
             its default with Curvature); VTK vtkPCANormalEstimation k 20 +
             GRAPH_TRAVERSAL; Open3D PCA k 20 + orient_normals_consistent_tangent_plane; PCL pcl_normal_estimation

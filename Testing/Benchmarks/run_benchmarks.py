@@ -7,7 +7,7 @@
 The plugin comes from $MESHFREE_PLUGIN, else from <source>/build. --out defaults to
 <build>/benchmark-results. --only takes a comma list of approximation,sph,solid (default: all three).
 --threads N puts every tool on N threads (default: all cores; on a machine shared with other work, --threads 1
-gives a fair comparison, since OpenMP and thread pools wait for descheduled threads at every barrier).
+gives a fair comparison, since OpenMP and other fork-join pools wait for descheduled threads at every barrier).
 Writes approximation.csv, sph.csv, solid.csv, pareto.md and the PNGs (bench_report.py draws them).
 
 approximation.csv  method,peer,n,degree,rms_error,max_error,seconds,evals_per_second
@@ -73,15 +73,14 @@ import sys
 import time
 
 os.environ.setdefault("VTK_SMP_BACKEND_IN_USE", "STDThread")
-os.environ.setdefault("OMP_WAIT_POLICY", "passive")
-# --threads N: every tool on N threads (OpenMP in MeshFree's core, VTK's SMP pool, BLAS under SciPy). Set before
+# --threads N: every tool on N threads (MeshFree's core, VTK's SMP pool, BLAS under SciPy). Set before
 # numpy, VTK or the plugin load their thread pools.
 THREADS = None
 for _i, _a in enumerate(sys.argv):
     if _a.startswith("--threads"):
         THREADS = int(_a.split("=", 1)[1] if "=" in _a else sys.argv[_i + 1])
 if THREADS:
-    for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    for _v in ("MESHFREE_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[_v] = str(THREADS)
 
 import numpy as np  # noqa: E402

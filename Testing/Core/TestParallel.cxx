@@ -95,9 +95,12 @@ TEST(Parallel, EmptyTinyAndSerialBelow)
   EXPECT_EQ(seenBegin, 0);
   EXPECT_EQ(seenEnd, 10);
   calls = 0; // below serialBelow: one call over everything
-  meshfree::ParallelFor(5000, 8, [&](Index b, Index e) { calls += (b == 0 && e == 5000) ? 1 : 100; }, 10000);
+  meshfree::ParallelFor(
+    5000, 8, [&](Index b, Index e) { calls += (b == 0 && e == 5000) ? 1 : 100; }, 10000);
   EXPECT_EQ(calls, 1);
-  EXPECT_EQ(meshfree::ParallelReduce(0, 8, 7.0, [](Index, Index) { return 1.0; }, [](double a, double b) { return a + b; }), 7.0);
+  EXPECT_EQ(meshfree::ParallelReduce(
+              0, 8, 7.0, [](Index, Index) { return 1.0; }, [](double a, double b) { return a + b; }),
+    7.0);
 }
 
 TEST(Parallel, ReductionIsTheSameWhateverTheThreads)
@@ -242,8 +245,8 @@ TEST(Parallel, NeighborGridRowsDoNotDependOnTheThreads)
   {
     c = u(random);
   }
-  auto run = [&](int threads, std::vector<Index>& offsets, std::vector<std::int32_t>& rows,
-               std::vector<Index>& knn, std::vector<double>& knnDist2) {
+  auto run = [&](int threads, std::vector<Index>& offsets, std::vector<std::int32_t>& rows, std::vector<Index>& knn,
+               std::vector<double>& knnDist2) {
     meshfree::SetMaxThreads(threads);
     meshfree::NeighborGrid grid;
     ASSERT_TRUE(grid.Build(xyz.data(), static_cast<Index>(xyz.size() / 3), 0.01));

@@ -7,7 +7,6 @@ import sys
 
 import numpy as np
 
-os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import meshfree_test  # noqa: E402

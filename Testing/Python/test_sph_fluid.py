@@ -4,7 +4,6 @@ import sys
 
 import numpy as np
 
-os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import meshfree_test  # noqa: E402
 

@@ -15,7 +15,7 @@ def run(name, script, args, expected, folder=FIGURES):
     out = os.path.join(os.environ["MESHFREE_TEST_OUTPUT"], "figures_" + name)
     shutil.rmtree(out, ignore_errors=True)
     cmd = [PVPYTHON, "--no-mpi", os.path.join(folder, script)] + args + ["--out", out]
-    env = dict(os.environ, OMP_WAIT_POLICY="passive")
+    env = dict(os.environ)
     for attempt in range(3):
         result = subprocess.run(cmd, capture_output=True, text=True, cwd=folder, env=env)
         log = result.stdout + result.stderr

@@ -143,20 +143,17 @@ void RadixSort(std::uint64_t*& v, std::uint64_t*& scratch, Index m, int lowBit, 
     const int shift = lowBit + pass * digitBits;
     const std::uint64_t* in = v;
     std::uint64_t* out = scratch;
-    ParallelFor(chunks,
-      1,
-      [&](Index begin, Index end)
+    ParallelFor(chunks, 1, [&](Index begin, Index end) {
+      for (int c = static_cast<int>(begin); c < end; ++c)
       {
-        for (int c = static_cast<int>(begin); c < end; ++c)
+        Index* count = offsets.data() + buckets * c;
+        std::fill(count, count + buckets, Index(0));
+        for (Index i = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); i < e; ++i)
         {
-          Index* count = offsets.data() + buckets * c;
-          std::fill(count, count + buckets, Index(0));
-          for (Index i = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); i < e; ++i)
-          {
-            ++count[(in[i] >> shift) & mask];
-          }
+          ++count[(in[i] >> shift) & mask];
         }
-      });
+      }
+    });
     Index sum = 0;
     bool oneBucket = false;
     for (std::size_t b = 0; b < buckets; ++b)
@@ -175,19 +172,16 @@ void RadixSort(std::uint64_t*& v, std::uint64_t*& scratch, Index m, int lowBit, 
     {
       continue;
     }
-    ParallelFor(chunks,
-      1,
-      [&](Index begin, Index end)
+    ParallelFor(chunks, 1, [&](Index begin, Index end) {
+      for (int c = static_cast<int>(begin); c < end; ++c)
       {
-        for (int c = static_cast<int>(begin); c < end; ++c)
+        Index* next = offsets.data() + buckets * c;
+        for (Index i = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); i < e; ++i)
         {
-          Index* next = offsets.data() + buckets * c;
-          for (Index i = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); i < e; ++i)
-          {
-            out[next[(in[i] >> shift) & mask]++] = in[i];
-          }
+          out[next[(in[i] >> shift) & mask]++] = in[i];
         }
-      });
+      }
+    });
     std::swap(v, scratch);
   }
 }
@@ -391,42 +385,38 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   // Pass 1: bounds and number of valid points, per chunk (pass 2 compacts with the same chunks). Chunks of at
   // least 32,768 points, several per thread so that running threads take a descheduled one's chunks; the
   // results do not depend on their number.
-  const int chunks =
-    n >= ParallelThreshold
-      ? static_cast<int>(std::min<Index>(std::max<Index>(n / 32768, 1), 8 * static_cast<Index>(MaxThreads())))
-      : 1;
+  const int chunks = n >= ParallelThreshold
+    ? static_cast<int>(std::min<Index>(std::max<Index>(n / 32768, 1), 8 * static_cast<Index>(MaxThreads())))
+    : 1;
   std::vector<Index> validBefore(chunks + 1, 0);
   std::vector<double> chunkBounds(6 * chunks);
-  ParallelFor(chunks,
-    1,
-    [&](Index begin, Index end)
+  ParallelFor(chunks, 1, [&](Index begin, Index end) {
+    for (int c = static_cast<int>(begin); c < end; ++c)
     {
-      for (int c = static_cast<int>(begin); c < end; ++c)
+      double lo[3] = { Infinity, Infinity, Infinity };
+      double hi[3] = { -Infinity, -Infinity, -Infinity };
+      Index valid = 0;
+      for (Index i = ChunkBegin(n, c, chunks), e = ChunkBegin(n, c + 1, chunks); i < e; ++i)
       {
-        double lo[3] = { Infinity, Infinity, Infinity };
-        double hi[3] = { -Infinity, -Infinity, -Infinity };
-        Index valid = 0;
-        for (Index i = ChunkBegin(n, c, chunks), e = ChunkBegin(n, c + 1, chunks); i < e; ++i)
+        const double* p = xyz + 3 * i;
+        if (IsFinite3(p))
         {
-          const double* p = xyz + 3 * i;
-          if (IsFinite3(p))
+          ++valid;
+          for (int a = 0; a < 3; ++a)
           {
-            ++valid;
-            for (int a = 0; a < 3; ++a)
-            {
-              lo[a] = std::min(lo[a], p[a]);
-              hi[a] = std::max(hi[a], p[a]);
-            }
+            lo[a] = std::min(lo[a], p[a]);
+            hi[a] = std::max(hi[a], p[a]);
           }
         }
-        validBefore[c + 1] = valid;
-        for (int a = 0; a < 3; ++a)
-        {
-          chunkBounds[6 * c + 2 * a] = lo[a];
-          chunkBounds[6 * c + 2 * a + 1] = hi[a];
-        }
       }
-    });
+      validBefore[c + 1] = valid;
+      for (int a = 0; a < 3; ++a)
+      {
+        chunkBounds[6 * c + 2 * a] = lo[a];
+        chunkBounds[6 * c + 2 * a + 1] = hi[a];
+      }
+    }
+  });
   double lo[3] = { Infinity, Infinity, Infinity };
   double hi[3] = { -Infinity, -Infinity, -Infinity };
   for (int c = 0; c < chunks; ++c)
@@ -515,30 +505,27 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   this->SortScratch.resize(m);
   std::vector<std::pair<std::uint64_t, Index>> pairs(packed ? 0 : m);
   std::uint64_t* keys = this->CellKeys.data();
-  ParallelFor(chunks,
-    1,
-    [&](Index begin, Index end)
+  ParallelFor(chunks, 1, [&](Index begin, Index end) {
+    for (int c = static_cast<int>(begin); c < end; ++c)
     {
-      for (int c = static_cast<int>(begin); c < end; ++c)
+      Index out = validBefore[c];
+      for (Index i = ChunkBegin(n, c, chunks), e = ChunkBegin(n, c + 1, chunks); i < e; ++i)
       {
-        Index out = validBefore[c];
-        for (Index i = ChunkBegin(n, c, chunks), e = ChunkBegin(n, c + 1, chunks); i < e; ++i)
+        const double* p = xyz + 3 * i;
+        if (IsFinite3(p))
         {
-          const double* p = xyz + 3 * i;
-          if (IsFinite3(p))
+          if (packed)
           {
-            if (packed)
-            {
-              keys[out++] = (cellKey(p) << keyShift) | static_cast<std::uint64_t>(i);
-            }
-            else
-            {
-              pairs[out++] = { cellKey(p), i };
-            }
+            keys[out++] = (cellKey(p) << keyShift) | static_cast<std::uint64_t>(i);
+          }
+          else
+          {
+            pairs[out++] = { cellKey(p), i };
           }
         }
       }
-    });
+    }
+  });
   if (packed)
   {
     std::uint64_t* scratch = this->SortScratch.data();
@@ -559,36 +546,33 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   keys = this->CellKeys.data();
   Index* order = this->Order.data();
   double* sorted = this->Sorted.data();
-  ParallelFor(chunks,
-    1,
-    [&](Index begin, Index end)
+  ParallelFor(chunks, 1, [&](Index begin, Index end) {
+    for (int c = static_cast<int>(begin); c < end; ++c)
     {
-      for (int c = static_cast<int>(begin); c < end; ++c)
+      for (Index s = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); s < e; ++s)
       {
-        for (Index s = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); s < e; ++s)
+        Index i;
+        if (packed)
         {
-          Index i;
-          if (packed)
+          i = static_cast<Index>(keys[s] & idxMask);
+          keys[s] >>= keyShift;
+          if (s + 16 < e) // the reads are random for a cloud in random order: fetch ahead
           {
-            i = static_cast<Index>(keys[s] & idxMask);
-            keys[s] >>= keyShift;
-            if (s + 16 < e) // the reads are random for a cloud in random order: fetch ahead
-            {
-              MESHFREE_GRID_PREFETCH(xyz + 3 * static_cast<Index>(keys[s + 16] & idxMask));
-            }
+            MESHFREE_GRID_PREFETCH(xyz + 3 * static_cast<Index>(keys[s + 16] & idxMask));
           }
-          else
-          {
-            i = pairs[s].second;
-            keys[s] = pairs[s].first;
-          }
-          order[s] = i;
-          sorted[3 * s] = xyz[3 * i];
-          sorted[3 * s + 1] = xyz[3 * i + 1];
-          sorted[3 * s + 2] = xyz[3 * i + 2];
         }
+        else
+        {
+          i = pairs[s].second;
+          keys[s] = pairs[s].first;
+        }
+        order[s] = i;
+        sorted[3 * s] = xyz[3 * i];
+        sorted[3 * s + 1] = xyz[3 * i + 1];
+        sorted[3 * s + 2] = xyz[3 * i + 2];
       }
-    });
+    }
+  });
 
   // Cell ranges: a run of equal keys is one cell.
   const Index cellCount = dims[0] * dims[1] * dims[2];
@@ -602,10 +586,8 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   };
   const Index serialBelow = chunks > 1 ? 0 : std::max(cellCount, m) + 1;
   ParallelFor(
-    cellCount,
-    16384,
-    [&](Index begin, Index end)
-    {
+    cellCount, 16384,
+    [&](Index begin, Index end) {
       for (Index c = begin; c < end; ++c)
       {
         cells[c] = CellRange{ 0, 0 };
@@ -613,10 +595,8 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
     },
     serialBelow);
   ParallelFor(
-    m,
-    8192,
-    [&](Index begin, Index end)
-    {
+    m, 8192,
+    [&](Index begin, Index end) {
       for (Index s = begin; s < end; ++s)
       {
         if (s == 0 || keys[s] != keys[s - 1])
@@ -1112,11 +1092,8 @@ Index NeighborGrid::FindDuplicates(std::vector<Index>& representative) const
   // Equal coordinates fall into one cell: sort each cell's points by (x, y, z, index) and group.
   std::vector<std::vector<Index>> posPerThread(MaxThreads());
   duplicates = ParallelReduce(
-    cells,
-    1024,
-    Index(0),
-    [&](Index begin, Index end)
-    {
+    cells, 1024, Index(0),
+    [&](Index begin, Index end) {
       std::vector<Index>& pos = posPerThread[ThreadIndex()];
       Index found = 0; // this block's duplicates
       for (Index c = begin; c < end; ++c)
@@ -1131,26 +1108,23 @@ Index NeighborGrid::FindDuplicates(std::vector<Index>& representative) const
         {
           pos.push_back(s);
         }
-        std::sort(pos.begin(),
-          pos.end(),
-          [xyz, order](Index a, Index b)
+        std::sort(pos.begin(), pos.end(), [xyz, order](Index a, Index b) {
+          for (int k = 0; k < 3; ++k)
           {
-            for (int k = 0; k < 3; ++k)
+            if (xyz[3 * a + k] != xyz[3 * b + k])
             {
-              if (xyz[3 * a + k] != xyz[3 * b + k])
-              {
-                return xyz[3 * a + k] < xyz[3 * b + k];
-              }
+              return xyz[3 * a + k] < xyz[3 * b + k];
             }
-            return order[a] < order[b];
-          });
+          }
+          return order[a] < order[b];
+        });
         Index first = pos[0];
         representative[order[first]] = order[first];
         for (size_t j = 1; j < pos.size(); ++j)
         {
           const Index s = pos[j];
           const bool same = xyz[3 * s] == xyz[3 * first] && xyz[3 * s + 1] == xyz[3 * first + 1] &&
-                            xyz[3 * s + 2] == xyz[3 * first + 2];
+            xyz[3 * s + 2] == xyz[3 * first + 2];
           if (!same)
           {
             first = s;
@@ -1492,10 +1466,8 @@ bool NeighborGrid::FindWithinRadiusForAllPoints(
   std::int32_t* rowThreadData = rowThread.data();
   SlotScratch* slotData = slots.data(); // thread_local names inside the loop's body would be the workers' own
   ParallelFor(
-    cellCount,
-    64,
-    [&](Index begin, Index end)
-    {
+    cellCount, 64,
+    [&](Index begin, Index end) {
       const int t = ThreadIndex();
       SlotScratch& slot = slotData[t];
       detail::Buffer<std::int32_t>& out = slot.Rows;
@@ -1571,10 +1543,9 @@ bool NeighborGrid::FindWithinRadiusForAllPoints(
         }
         for (Index p = own.Begin; p < own.End; ++p)
         {
-          const int found =
-            ranges.empty()
-              ? 0
-              : Filter(xyz, ranges.data(), static_cast<int>(ranges.size()), xyz + 3 * p, r2, nullptr, pos.data());
+          const int found = ranges.empty()
+            ? 0
+            : Filter(xyz, ranges.data(), static_cast<int>(ranges.size()), xyz + 3 * p, r2, nullptr, pos.data());
           if (out.size() < used + static_cast<std::size_t>(found))
           {
             out.resize(2 * (used + static_cast<std::size_t>(found)));
@@ -1605,16 +1576,13 @@ bool NeighborGrid::FindWithinRadiusForAllPoints(
   }
   ids.resize(static_cast<std::size_t>(offsets[static_cast<std::size_t>(n)]));
   ParallelFor(
-    valid,
-    1024,
-    [&](Index begin, Index end)
-    {
+    valid, 1024,
+    [&](Index begin, Index end) {
       for (Index p = begin; p < end; ++p)
       {
         const Index i = order[p];
         const std::int32_t* from = buffers[static_cast<std::size_t>(rowThreadData[p])] + rowStartData[p];
-        std::copy(from,
-          from + (offsets[static_cast<std::size_t>(i) + 1] - offsets[static_cast<std::size_t>(i)]),
+        std::copy(from, from + (offsets[static_cast<std::size_t>(i) + 1] - offsets[static_cast<std::size_t>(i)]),
           ids.begin() + offsets[static_cast<std::size_t>(i)]);
       }
     },
@@ -1651,10 +1619,8 @@ void NeighborGrid::FindKNearestForAllPoints(
   // In Morton order consecutive queries are neighbours: the previous k-th distance, slightly enlarged,
   // is a good first cut for the next query.
   ParallelFor(
-    m,
-    1024,
-    [&](Index begin, Index end)
-    {
+    m, 1024,
+    [&](Index begin, Index end) {
       double cut = 0.0;
       for (Index s = begin; s < end; ++s)
       {

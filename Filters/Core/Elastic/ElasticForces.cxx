@@ -115,10 +115,8 @@ void ElasticSolid::ComputePackets(const double* x, std::vector<double>& packet, 
   selfForce.resize(3 * n);
   edge.resize(hourglass ? 3 * static_cast<size_t>(n) * k : 0);
   ParallelFor(
-    n,
-    256,
-    [&](Index begin, Index end)
-    {
+    n, 256,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         double C[27], F[9];
@@ -172,10 +170,8 @@ void ElasticSolid::GatherForces(const std::vector<double>& packet, const std::ve
   const bool hourglass = !edge.empty();
   f.resize(3 * n);
   ParallelFor(
-    n,
-    512,
-    [&](Index begin, Index end)
-    {
+    n, 512,
+    [&](Index begin, Index end) {
       for (Index j = begin; j < end; ++j)
       {
         double acc[3] = { selfForce[3 * j], selfForce[3 * j + 1], selfForce[3 * j + 2] };
@@ -217,11 +213,8 @@ double ElasticSolid::InternalEnergy(const double* x) const
   const bool plastic = !this->Current.PlasticStrain.empty();
   double energy = 0.0;
   energy += ParallelReduce(
-    n,
-    256,
-    decltype(energy)(0),
-    [&](Index begin, Index end)
-    {
+    n, 256, decltype(energy)(0),
+    [&](Index begin, Index end) {
       decltype(energy) energy = 0; // this block's part
       for (Index i = begin; i < end; ++i)
       {
@@ -263,8 +256,7 @@ double ElasticSolid::InternalEnergy(const double* x) const
       }
       return energy;
     },
-    [](decltype(energy) a, decltype(energy) b) { return a + b; },
-    kElasticParallel + 1);
+    [](decltype(energy) a, decltype(energy) b) { return a + b; }, kElasticParallel + 1);
   return energy;
 }
 
@@ -279,10 +271,8 @@ void ElasticSolid::ComputeDeformation(std::vector<double>& Fs, std::vector<doubl
   const double* x = this->Current.Position.data();
   const bool plastic = !this->Current.PlasticStrain.empty();
   ParallelFor(
-    n,
-    256,
-    [&](Index begin, Index end)
-    {
+    n, 256,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         double* F = &Fs[9 * i];

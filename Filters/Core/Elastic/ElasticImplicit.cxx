@@ -93,10 +93,8 @@ void ElasticSolid::ApplyHessian(
   self.resize(3 * n);
   edge.resize(hourglass ? 3 * static_cast<size_t>(n) * k : 0);
   ParallelFor(
-    n,
-    256,
-    [&](Index begin, Index end)
-    {
+    n, 256,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         double dC[27], dF[9];
@@ -176,10 +174,8 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
   std::vector<double> Splus(9 * n);
   const bool plastic = !this->Current.PlasticStrain.empty();
   ParallelFor(
-    n,
-    256,
-    [&](Index begin, Index end)
-    {
+    n, 256,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         const double* F = &Fs[9 * i];
@@ -246,10 +242,8 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
   auto apply = [&](const std::vector<double>& in, std::vector<double>& result) {
     this->ApplyHessian(Fs, Splus, in.data(), result);
     ParallelFor(
-      n,
-      4096,
-      [&](Index begin, Index end)
-      {
+      n, 4096,
+      [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
           for (int a = 0; a < 3; ++a)
@@ -352,10 +346,8 @@ int ElasticSolid::StepImplicit(double dt, double& residual, double tolerance, in
   }
 
   ParallelFor(
-    n,
-    4096,
-    [&](Index begin, Index end)
-    {
+    n, 4096,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         for (int a = 0; a < 3; ++a)

@@ -49,10 +49,8 @@ void ElasticSolid::AddContactForces(const double* x, std::vector<double>& f)
   std::vector<std::vector<Index>> idsPerThread(MaxThreads());
   std::vector<std::vector<double>> d2PerThread(MaxThreads());
   ParallelFor(
-    m,
-    256,
-    [&](Index begin, Index end)
-    {
+    m, 256,
+    [&](Index begin, Index end) {
       std::vector<Index>& ids = idsPerThread[ThreadIndex()];
       std::vector<double>& d2 = d2PerThread[ThreadIndex()];
       for (Index s = begin; s < end; ++s)
@@ -142,10 +140,8 @@ void ElasticSolid::ApplyContainer(double* x, double* v) const
     }
   };
   ParallelFor(
-    n,
-    2048,
-    [&](Index begin, Index end)
-    {
+    n, 2048,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         double* p = x + 3 * i;
@@ -193,10 +189,8 @@ void ElasticSolid::UpdatePlasticity(double dt)
   const ElasticSettings& s = this->Config;
   const double creep = std::min(1.0, dt * s.PlasticCreep);
   ParallelFor(
-    this->N,
-    1024,
-    [&](Index begin, Index end)
-    {
+    this->N, 1024,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         const double* F = &this->DefGrad[9 * i];
@@ -248,10 +242,8 @@ void ElasticSolid::StepSymplectic(double dt)
   const double* g = this->Config.Gravity;
   const double damp = 1.0 / (1.0 + dt * this->Config.Damping);
   ParallelFor(
-    n,
-    4096,
-    [&](Index begin, Index end)
-    {
+    n, 4096,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         if (this->IsFixed[i])

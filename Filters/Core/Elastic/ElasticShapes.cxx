@@ -240,10 +240,8 @@ void InsideMesh(const std::vector<double>& p, const std::vector<Index>& t, const
   inside.assign(nq, 0);
   const Index nt = static_cast<Index>(t.size() / 3);
   ParallelFor(
-    nq,
-    64,
-    [&](Index begin, Index end)
-    {
+    nq, 64,
+    [&](Index begin, Index end) {
       for (Index q = begin; q < end; ++q)
       {
         const double* x = &queries[3 * q];
@@ -261,7 +259,7 @@ void InsideMesh(const std::vector<double>& p, const std::vector<Index>& t, const
           const double lb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
           const double lc = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
           const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                             a[2] * (b[0] * c[1] - b[1] * c[0]);
+            a[2] * (b[0] * c[1] - b[1] * c[0]);
           const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
           const double ac = a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
           const double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
@@ -321,10 +319,8 @@ void ElasticSurface::Bind(const ElasticSolid& solid, const std::vector<double>& 
   std::vector<std::vector<Index>> idsPerThread(MaxThreads());
   std::vector<std::vector<double>> d2PerThread(MaxThreads());
   ParallelFor(
-    nv,
-    256,
-    [&](Index begin, Index end)
-    {
+    nv, 256,
+    [&](Index begin, Index end) {
       std::vector<Index>& ids = idsPerThread[ThreadIndex()];
       std::vector<double>& d2 = d2PerThread[ThreadIndex()];
       for (Index v = begin; v < end; ++v)
@@ -356,10 +352,8 @@ void ElasticSurface::Deform(const ElasticSolid& solid, const std::vector<double>
   const std::vector<double>& X = solid.RestPositions();
   const std::vector<double>& x = solid.State().Position;
   ParallelFor(
-    nv,
-    1024,
-    [&](Index begin, Index end)
-    {
+    nv, 1024,
+    [&](Index begin, Index end) {
       for (Index v = begin; v < end; ++v)
       {
         const double* P = &this->RestVertices[3 * v];

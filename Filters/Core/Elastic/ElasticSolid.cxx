@@ -89,10 +89,8 @@ bool ElasticSolid::Initialize(
     std::vector<std::vector<Index>> idsPerThread(MaxThreads());
     std::vector<std::vector<double>> d2PerThread(MaxThreads());
     ParallelFor(
-      n,
-      256,
-      [&](Index begin, Index end)
-      {
+      n, 256,
+      [&](Index begin, Index end) {
         std::vector<Index>& ids = idsPerThread[ThreadIndex()];
         std::vector<double>& d2 = d2PerThread[ThreadIndex()];
         for (Index i = begin; i < end; ++i)
@@ -137,11 +135,8 @@ bool ElasticSolid::Initialize(
   Index illConditioned = 0;
 
   illConditioned += ParallelReduce(
-    n,
-    1024,
-    decltype(illConditioned)(0),
-    [&](Index begin, Index end)
-    {
+    n, 1024, decltype(illConditioned)(0),
+    [&](Index begin, Index end) {
       decltype(illConditioned) illConditioned = 0; // this block's part
       for (Index i = begin; i < end; ++i)
       {
@@ -274,8 +269,7 @@ bool ElasticSolid::Initialize(
       }
       return illConditioned;
     },
-    [](decltype(illConditioned) a, decltype(illConditioned) b) { return a + b; },
-    kElasticParallel + 1);
+    [](decltype(illConditioned) a, decltype(illConditioned) b) { return a + b; }, kElasticParallel + 1);
   this->IllConditioned = illConditioned;
 
   // Masses m_i = s rbar_i^3 rho [4.15], s from the body's volume; volumes m_i / rho [4.22].

@@ -48,10 +48,8 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
   std::int32_t* rowThread = this->BoundaryRowThread.data();
   Index* counts = this->BoundaryStart.data() + 1;
   ParallelFor(
-    n,
-    512,
-    [&](Index begin, Index end)
-    {
+    n, 512,
+    [&](Index begin, Index end) {
       const int t = ThreadIndex();
       std::vector<std::int32_t>& wall = this->ThreadBoundary[t];
       std::vector<Index>& ids = threadIds[t];
@@ -79,10 +77,8 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
   const Index* start = this->BoundaryStart.data();
   std::int32_t* rows = this->BoundaryNeighbors.data();
   ParallelFor(
-    n,
-    4096,
-    [&](Index begin, Index end)
-    {
+    n, 4096,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         if (start[i + 1] > start[i])
@@ -126,10 +122,8 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
 
   // Density (5.32) and pressure (5.40 / Tait).
   ParallelFor(
-    n,
-    512,
-    [&](Index begin, Index end)
-    {
+    n, 512,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         const double* xi = x + 3 * i;
@@ -173,10 +167,8 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
     this->BoundaryActive.assign(nb, 0);
     const Index total = bs[n];
     ParallelFor(
-      total,
-      1024,
-      [&](Index begin, Index end)
-      {
+      total, 1024,
+      [&](Index begin, Index end) {
         for (Index s = begin; s < end; ++s)
         {
           this->BoundaryActive[bn[s]] = 1; // same value from every thread
@@ -187,10 +179,8 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
     const char* active = this->BoundaryActive.data();
     std::vector<std::vector<Index>> threadIds(MaxThreads());
     ParallelFor(
-      nb,
-      256,
-      [&](Index begin, Index end)
-      {
+      nb, 256,
+      [&](Index begin, Index end) {
         std::vector<Index>& ids = threadIds[ThreadIndex()];
         for (Index b = begin; b < end; ++b)
         {
@@ -234,10 +224,8 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   const bool artificial = avFactor > 0.0;
   const double pressureFactor = m * gradientNorm, viscousFactor = mu * m * visc;
   ParallelFor(
-    n,
-    256,
-    [&](Index begin, Index end)
-    {
+    n, 256,
+    [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         const double* xi = x + 3 * i;
@@ -247,8 +235,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
         double ap[3] = { 0.0, 0.0, 0.0 }, av[3] = { 0.0, 0.0, 0.0 }, normal[3] = { 0.0, 0.0, 0.0 };
         double colourLaplacian = 0.0;
         // Colour field c = sum_j V_j W_poly6: grad W = gradient r, lap W = -6 poly6 q (d q - 4 r^2), q = h^2 - r^2.
-        auto addColour = [&](double volume, const double r[3], double r2)
-        {
+        auto addColour = [&](double volume, const double r[3], double r2) {
           const double q = h2 - r2;
           const double gradient = -6.0 * poly6 * q * q;
           normal[0] += volume * gradient * r[0];
@@ -406,14 +393,11 @@ void SPHFluid::Reorder(SPHState& state)
   {
     return;
   }
-  auto permute3 = [&](std::vector<double>& a)
-  {
+  auto permute3 = [&](std::vector<double>& a) {
     std::vector<double> b(a.size());
     ParallelFor(
-      n,
-      8192,
-      [&](Index begin, Index end)
-      {
+      n, 8192,
+      [&](Index begin, Index end) {
         for (Index s = begin; s < end; ++s)
         {
           b[3 * s] = a[3 * order[s]];
@@ -447,11 +431,8 @@ double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
   Extremes identity;
   identity.Rho = this->Params.RestDensity;
   const Extremes e = ParallelReduce(
-    n,
-    4096,
-    identity,
-    [&](Index begin, Index end)
-    {
+    n, 4096, identity,
+    [&](Index begin, Index end) {
       Extremes m = identity;
       for (Index i = begin; i < end; ++i)
       {
@@ -466,8 +447,7 @@ double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
       }
       return m;
     },
-    [](Extremes x, const Extremes& y)
-    {
+    [](Extremes x, const Extremes& y) {
       x.V2 = std::max(x.V2, y.V2);
       x.A2 = std::max(x.A2, y.A2);
       x.Rho = std::max(x.Rho, y.Rho);
@@ -565,10 +545,8 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
     // Kick - drift (with the wall and obstacle projection).
     const double half = 0.5 * dt;
     ParallelFor(
-      n,
-      2048,
-      [&](Index begin, Index end)
-      {
+      n, 2048,
+      [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
           double* x = &state.Position[3 * i];
@@ -590,10 +568,8 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
     this->ComputeAccelerations(state);
     // Kick.
     ParallelFor(
-      3 * n,
-      16384,
-      [&](Index begin, Index end)
-      {
+      3 * n, 16384,
+      [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
           state.Velocity[i] += half * state.Acceleration[i];
@@ -623,10 +599,8 @@ std::vector<int> SPHFluid::NeighborCounts(const SPHState& state)
   std::vector<std::vector<Index>> threadIds(MaxThreads());
   std::vector<std::vector<double>> threadDistances(MaxThreads());
   ParallelFor(
-    n,
-    256,
-    [&](Index begin, Index end)
-    {
+    n, 256,
+    [&](Index begin, Index end) {
       std::vector<Index>& ids = threadIds[ThreadIndex()];
       std::vector<double>& d2 = threadDistances[ThreadIndex()];
       for (Index i = begin; i < end; ++i)
@@ -665,8 +639,8 @@ SPHStatistics SPHFluid::Statistics(const SPHState& state, double mass)
     s.MinDensity = std::min(s.MinDensity, state.Density[i]);
     s.MaxDensity = std::max(s.MaxDensity, state.Density[i]);
     s.Finite = s.Finite && std::isfinite(v2) && std::isfinite(state.Position[3 * i]) &&
-               std::isfinite(state.Position[3 * i + 1]) && std::isfinite(state.Position[3 * i + 2]) &&
-               std::isfinite(state.Density[i]) && std::isfinite(state.Pressure[i]);
+      std::isfinite(state.Position[3 * i + 1]) && std::isfinite(state.Position[3 * i + 2]) &&
+      std::isfinite(state.Density[i]) && std::isfinite(state.Pressure[i]);
   }
   return s;
 }

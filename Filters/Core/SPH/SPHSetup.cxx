@@ -10,8 +10,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <omp.h>
-
 namespace meshfree
 {
 namespace
