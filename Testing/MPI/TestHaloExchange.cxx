@@ -238,7 +238,9 @@ int main(int argc, char* argv[])
     knn->ExchangeForKNearest(piece, queries.data(), static_cast<vtkIdType>(mine.size()), 12);
     double knnRegion[6];
     vtkMeshFreeHalo::FiniteBounds(queries.data(), static_cast<vtkIdType>(mine.size()), knnRegion);
-    CheckHalo(knn, xyz, mine, knnRegion, knn->GetRadius(), false);
+    const vtkIdType knnReceived = CheckHalo(knn, xyz, mine, knnRegion, knn->GetRadius(), false);
+    std::printf("slabs, 12 nearest: rank %d radius %g, receives %lld halo points (%.1f %% of the cloud)\n", Rank,
+      knn->GetRadius(), static_cast<long long>(knnReceived), 100.0 * knnReceived / n);
     std::vector<vtkIdType> sample;
     for (size_t i = 0; i < mine.size(); i += 37)
     {
