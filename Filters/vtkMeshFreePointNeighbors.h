@@ -11,6 +11,12 @@
  * Points with NaN/Inf coordinates are excluded from the grid, get 0 in both arrays and 0 in
  * `vtkValidPointMask`; a warning gives their count. The output is a shallow copy of the input plus these arrays.
  *
+ * Distributed (a controller with several processes, e.g. pvbatch or pvserver under mpiexec): each rank's
+ * output is its own piece, with the values the serial run gives on the whole cloud. The rank first receives
+ * the remote points its points need (vtkMeshFreeHalo: the k + 1 nearest of each point, every point within
+ * SearchRadius), then searches the local + halo cloud ordered by global id, as the serial run orders it.
+ * Every rank must execute the filter, including ranks with an empty piece.
+ *
  * @sa vtkStaticPointLocator
  */
 #ifndef vtkMeshFreePointNeighbors_h
@@ -18,6 +24,8 @@
 
 #include "MeshFreeFiltersModule.h"
 #include "vtkPointSetAlgorithm.h"
+
+class vtkMultiProcessController;
 
 class MESHFREEFILTERS_EXPORT vtkMeshFreePointNeighbors : public vtkPointSetAlgorithm
 {
@@ -42,14 +50,24 @@ public:
   vtkGetMacro(SearchRadius, double);
   ///@}
 
+  ///@{
+  /**
+   * The controller over which the cloud is distributed. Default: the global controller (none, or one process:
+   * the input is the whole cloud).
+   */
+  void SetController(vtkMultiProcessController* controller);
+  vtkGetObjectMacro(Controller, vtkMultiProcessController);
+  ///@}
+
 protected:
   vtkMeshFreePointNeighbors();
-  ~vtkMeshFreePointNeighbors() override = default;
+  ~vtkMeshFreePointNeighbors() override;
 
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int NeighborCount = 10;
   double SearchRadius = 0.0;
+  vtkMultiProcessController* Controller = nullptr;
 
 private:
   vtkMeshFreePointNeighbors(const vtkMeshFreePointNeighbors&) = delete;
