@@ -432,17 +432,19 @@ SPHState SPHFluid::InitialState()
   Index outside = 0;
   std::vector<Index> nearest(1);
   std::vector<double> nearestD2(1);
-  // A node outside the obstacles' bounding box (grown by dx) cannot be inside one: only nodes within it take the
-  // nearest-sample normal test, whose answer far from a badly oriented obstacle would depend on ties between
-  // coincident samples, i.e. on the order of the triangles.
+  // A node outside the obstacles' bounding box cannot be inside one: only nodes within 10 spacings of that box take
+  // the nearest-sample normal test, whose answer far from an obstacle can depend on ties between coincident samples
+  // (edges, corners), i.e. on the order of the triangles. Within the 10 spacings the test is unchanged (it also drops
+  // some nodes in the plane of a face just beyond an edge, which the validated obstacle results include).
   double obstacleBox[6] = { 0.0, -1.0, 0.0, -1.0, 0.0, -1.0 };
+  const double grow = 10.0 * dx;
   for (std::size_t q = 0; q < this->ObstaclePosition.size(); q += 3)
   {
     for (int a = 0; a < 3; ++a)
     {
       const double v = this->ObstaclePosition[q + a];
-      obstacleBox[2 * a] = q == 0 ? v - dx : std::min(obstacleBox[2 * a], v - dx);
-      obstacleBox[2 * a + 1] = q == 0 ? v + dx : std::max(obstacleBox[2 * a + 1], v + dx);
+      obstacleBox[2 * a] = q == 0 ? v - grow : std::min(obstacleBox[2 * a], v - grow);
+      obstacleBox[2 * a + 1] = q == 0 ? v + grow : std::max(obstacleBox[2 * a + 1], v + grow);
     }
   }
   const bool flat = p.Dimension == 2; // y is ignored in 2D
