@@ -15,12 +15,15 @@
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#include "Parallel/vtkMeshFreePieces.h"
 #include "Elastic/ElasticShapes.h"
 #include "Elastic/ElasticSolid.h"
 #include "Common/StateCache.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <numeric>
 #include <utility>
 #include <string>
 #include <vector>
@@ -33,6 +36,13 @@ struct vtkMeshFreeDeformableSolid::Internals
   meshfree::ElasticSurface Surface;
   std::vector<double> SurfacePoints; // rest positions of the surface vertices
   std::vector<meshfree::Index> Triangles;
+  // The input surface gathered from every rank in canonical form (distinct points sorted, triangles sorted):
+  // what the model is built from, so that it does not depend on how the input was split.
+  std::vector<double> InputPoints;
+  std::vector<meshfree::Index> InputTriangles;
+  vtkIdType InputNonFinite = 0;     // points with a NaN/Inf coordinate, over all ranks
+  std::vector<vtkIdType> LocalToInput; // this rank's input points -> InputPoints
+  std::vector<vtkIdType> LocalTriangles; // this rank's input polygons, fan-triangulated (local point ids)
   meshfree::StateCache<meshfree::ElasticState> Cache{ 16 };
   vtkTimeStamp BuildTime;
   bool Valid = false;    // the model was built without error
@@ -78,7 +88,128 @@ vtkSmartPointer<vtkDoubleArray> MakeArray(const char* name, int components, vtkI
   std::copy(data, data + components * tuples, array->GetPointer(0));
   return array;
 }
+/// The local input surface: its points and its polygons fan-triangulated.
+void LocalSurface(vtkPolyData* input, std::vector<double>& points, std::vector<vtkIdType>& triangles)
+{
+  points.clear();
+  triangles.clear();
+  if (!input)
+  {
+    return;
+  }
+  points.resize(3 * static_cast<size_t>(input->GetNumberOfPoints()));
+  for (vtkIdType p = 0; p < input->GetNumberOfPoints(); ++p)
+  {
+    input->GetPoint(p, &points[3 * p]);
+  }
+  const vtkIdType* ids = nullptr;
+  vtkIdType count = 0;
+  vtkCellArray* polys = input->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(count, ids);)
+  {
+    for (vtkIdType t = 1; t + 1 < count; ++t) // fan triangulation of polygons
+    {
+      triangles.insert(triangles.end(), { ids[0], ids[t], ids[t + 1] });
+    }
+  }
+}
+
+/// Polydata of the deformed surface: output point k is vertex pointIndex[k] of the model's surface.
+vtkSmartPointer<vtkPolyData> SurfaceBlock(const std::vector<double>& deformed, const std::vector<double>& displacement,
+  const std::vector<double>& normals, const std::vector<vtkIdType>& pointIndex, const std::vector<vtkIdType>& triangles)
+{
+  const vtkIdType nv = static_cast<vtkIdType>(pointIndex.size());
+  std::vector<double> x(3 * nv), d(3 * nv), nn(3 * nv);
+  for (vtkIdType k = 0; k < nv; ++k)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      x[3 * k + a] = deformed[3 * pointIndex[k] + a];
+      d[3 * k + a] = displacement[3 * pointIndex[k] + a];
+      nn[3 * k + a] = normals[3 * pointIndex[k] + a];
+    }
+  }
+  auto surface = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> sp;
+  sp->SetDataTypeToDouble();
+  sp->SetNumberOfPoints(nv);
+  std::copy(x.begin(), x.end(), static_cast<double*>(sp->GetVoidPointer(0)));
+  surface->SetPoints(sp);
+  const vtkIdType nt = static_cast<vtkIdType>(triangles.size() / 3);
+  vtkNew<vtkIdTypeArray> toff, tconn;
+  toff->SetNumberOfTuples(nt + 1);
+  tconn->SetNumberOfTuples(3 * nt);
+  for (vtkIdType t = 0; t <= nt; ++t)
+  {
+    toff->SetValue(t, 3 * t);
+  }
+  std::copy(triangles.begin(), triangles.end(), tconn->GetPointer(0));
+  vtkNew<vtkCellArray> tris;
+  tris->SetData(toff, tconn);
+  surface->SetPolys(tris);
+  surface->GetPointData()->AddArray(MakeArray("Displacement", 3, nv, d.data()));
+  surface->GetPointData()->SetNormals(MakeArray("Normals", 3, nv, nn.data()));
+  return surface;
+}
 } // namespace
+
+void vtkMeshFreeDeformableSolid::GatherInputSurface(vtkPolyData* input, bool distributed)
+{
+  Internals& impl = *this->Impl;
+  std::vector<double> points;
+  LocalSurface(input, points, impl.LocalTriangles);
+  // Gathered: the points of every rank, and the triangles in the gathered points' numbering.
+  vtkIdType offset = 0;
+  const std::vector<double> allPoints = vtkMeshFreePieces::AllGather(points, distributed, &offset);
+  offset /= 3;
+  std::vector<double> local(impl.LocalTriangles.begin(), impl.LocalTriangles.end());
+  for (double& id : local)
+  {
+    id += static_cast<double>(offset);
+  }
+  const std::vector<double> allTriangles = vtkMeshFreePieces::AllGather(local, distributed);
+  impl.InputNonFinite = 0;
+  double scale = 0.0;
+  for (size_t p = 0; p < allPoints.size(); p += 3)
+  {
+    const bool finite =
+      std::isfinite(allPoints[p]) && std::isfinite(allPoints[p + 1]) && std::isfinite(allPoints[p + 2]);
+    impl.InputNonFinite += finite ? 0 : 1;
+    for (int a = 0; finite && a < 3; ++a)
+    {
+      scale = std::max(scale, std::fabs(allPoints[p + a]));
+    }
+  }
+  impl.InputPoints.clear();
+  impl.InputTriangles.clear();
+  impl.LocalToInput.clear();
+  if (impl.InputNonFinite > 0)
+  {
+    return; // BuildModel reports it
+  }
+  // Points that pieces share may come from their sources a rounding error apart: merged within 1e-12 of the
+  // coordinates' magnitude (float coordinates are 1e-7 apart at least, so distinct points stay distinct).
+  std::vector<vtkIdType> merged;
+  impl.InputPoints = vtkMeshFreePieces::MergePoints(allPoints, 1e-12 * scale, merged);
+  std::vector<std::array<meshfree::Index, 3>> triangles(allTriangles.size() / 3);
+  for (size_t t = 0; t < triangles.size(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      triangles[t][k] = merged[static_cast<vtkIdType>(allTriangles[3 * t + k])];
+    }
+    // Start at the smallest index, keeping the orientation.
+    std::rotate(triangles[t].begin(), std::min_element(triangles[t].begin(), triangles[t].end()), triangles[t].end());
+  }
+  std::sort(triangles.begin(), triangles.end());
+  triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+  for (const auto& triangle : triangles)
+  {
+    impl.InputTriangles.insert(impl.InputTriangles.end(), triangle.begin(), triangle.end());
+  }
+  const vtkIdType localPoints = static_cast<vtkIdType>(points.size() / 3);
+  impl.LocalToInput.assign(merged.begin() + offset, merged.begin() + offset + localPoints);
+}
 
 void vtkMeshFreeDeformableSolid::ReportInputWithoutPort(vtkObject* surface)
 {
@@ -99,10 +230,19 @@ int vtkMeshFreeDeformableSolid::RequestInformation(
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
   const double range[2] = { times.front(), times.back() };
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  // Every rank simulates the whole solid and outputs its share of the phyxels (see RequestData).
+  outInfo->Set(vtkAlgorithm::CAN_HANDLE_PIECE_REQUEST(), 1);
   return 1;
 }
 
-bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
+int vtkMeshFreeDeformableSolid::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkMeshFreePieces::RequestInput(outputVector->GetInformationObject(0), inputVector[0]->GetInformationObject(0));
+  return 1;
+}
+
+bool vtkMeshFreeDeformableSolid::BuildModel(bool fromInput)
 {
   Internals& impl = *this->Impl;
   impl.Valid = false;
@@ -148,39 +288,21 @@ bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
   // Phyxels and surface: the input's closed surface, or a built-in shape.
   std::vector<double> rest;
   double volume = 0.0;
-  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
   const auto tooMany = static_cast<meshfree::Index>(5e7);
-  if (input && input->GetNumberOfPoints() == 0)
+  if (fromInput && impl.InputNonFinite == 0 && impl.InputPoints.empty())
   {
     vtkErrorMacro("The input surface is empty: connect a closed surface, or no input to use Shape.");
     return false;
   }
-  if (input)
+  if (fromInput)
   {
-    vtkCellArray* polys = input->GetPolys();
-    impl.SurfacePoints.resize(3 * input->GetNumberOfPoints());
-    vtkIdType nonFinite = 0;
-    for (vtkIdType p = 0; p < input->GetNumberOfPoints(); ++p)
+    if (impl.InputNonFinite > 0)
     {
-      input->GetPoint(p, &impl.SurfacePoints[3 * p]);
-      const double* x = &impl.SurfacePoints[3 * p];
-      nonFinite += (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2])) ? 0 : 1;
-    }
-    if (nonFinite > 0)
-    {
-      vtkErrorMacro("The input surface has " << nonFinite << " points with NaN/Inf coordinates.");
-      impl.SurfacePoints.clear();
+      vtkErrorMacro("The input surface has " << impl.InputNonFinite << " points with NaN/Inf coordinates.");
       return false;
     }
-    const vtkIdType* ids = nullptr;
-    vtkIdType count = 0;
-    for (polys->InitTraversal(); polys->GetNextCell(count, ids);)
-    {
-      for (vtkIdType t = 1; t + 1 < count; ++t) // fan triangulation of polygons
-      {
-        impl.Triangles.insert(impl.Triangles.end(), { ids[0], ids[t], ids[t + 1] });
-      }
-    }
+    impl.SurfacePoints = impl.InputPoints;
+    impl.Triangles = impl.InputTriangles;
     // Closed: every edge is shared by exactly two triangles (in opposite directions for a consistent
     // orientation; the count alone catches holes and open sheets).
     std::vector<std::pair<vtkIdType, vtkIdType>> edges;
@@ -221,8 +343,15 @@ bool vtkMeshFreeDeformableSolid::BuildModel(vtkInformationVector** inputVector)
       impl.Triangles.clear();
       return false;
     }
-    double b[6];
-    input->GetBounds(b);
+    double b[6] = { VTK_DOUBLE_MAX, -VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, -VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, -VTK_DOUBLE_MAX };
+    for (meshfree::Index v : impl.Triangles) // the bounds of the polygons, as vtkPolyData::GetBounds
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        b[2 * a] = std::min(b[2 * a], impl.SurfacePoints[3 * v + a]);
+        b[2 * a + 1] = std::max(b[2 * a + 1], impl.SurfacePoints[3 * v + a]);
+      }
+    }
     std::vector<double> lattice;
     if (!meshfree::SampleLattice(b, this->PhyxelSpacing, [](const double*) { return true; }, lattice, tooMany))
     {
@@ -344,12 +473,19 @@ int vtkMeshFreeDeformableSolid::RequestData(
   Internals& impl = *this->Impl;
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector);
-  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
-  const bool hasInput = input && input->GetNumberOfPoints() > 0;
-  if (this->GetMTime() > impl.BuildTime || (input && input->GetMTime() > impl.BuildTime) ||
-    hasInput != impl.BuiltWithInput)
+  // The input surface, whole on every rank: under MPI each rank holds a piece (collective: every rank gathers,
+  // also with an empty piece). The model is rebuilt when the gathered surface changes, a decision that is the same
+  // on every rank.
+  const bool hasInput = this->GetNumberOfInputConnections(0) > 0;
+  const std::vector<double> inputPoints = std::move(impl.InputPoints);
+  const std::vector<meshfree::Index> inputTriangles = std::move(impl.InputTriangles);
+  const vtkIdType inputNonFinite = impl.InputNonFinite;
+  this->GatherInputSurface(hasInput ? vtkPolyData::GetData(inputVector[0], 0) : nullptr,
+    hasInput && vtkMeshFreePieces::IsDistributed(outInfo));
+  if (this->GetMTime() > impl.BuildTime || hasInput != impl.BuiltWithInput || inputPoints != impl.InputPoints ||
+    inputTriangles != impl.InputTriangles || inputNonFinite != impl.InputNonFinite)
   {
-    this->BuildModel(inputVector);
+    this->BuildModel(hasInput);
     impl.BuiltWithInput = hasInput;
     impl.BuildTime.Modified();
   }
@@ -444,15 +580,19 @@ int vtkMeshFreeDeformableSolid::RequestData(
   }
 
   // Phyxels block: positions and the fields of this state (strain and stress computed here only).
+  // Under MPI every rank holds the same state and outputs its share of the phyxels, so each is on one rank.
   const meshfree::ElasticSolid& solid = impl.Solid;
   const meshfree::ElasticState& state = solid.State();
-  const vtkIdType n = static_cast<vtkIdType>(solid.Size());
+  const vtkMeshFreePieces::Range share =
+    vtkMeshFreePieces::OutputShare(outInfo, static_cast<vtkIdType>(solid.Size()));
+  const vtkIdType n = share.Size();
+  const vtkIdType first = share.Begin;
   std::vector<double> F, strain, stress, det;
   solid.ComputeDeformation(F, strain, stress, det);
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(n);
-  std::copy(state.Position.begin(), state.Position.end(), static_cast<double*>(points->GetVoidPointer(0)));
+  std::copy_n(state.Position.begin() + 3 * first, 3 * n, static_cast<double*>(points->GetVoidPointer(0)));
   phyxels->SetPoints(points);
   vtkNew<vtkCellArray> verts;
   vtkNew<vtkIdTypeArray> offsets, connectivity;
@@ -464,62 +604,51 @@ int vtkMeshFreeDeformableSolid::RequestData(
   id->SetNumberOfTuples(n);
   for (vtkIdType i = 0; i < n; ++i)
   {
+    const vtkIdType s = first + i;
     offsets->SetValue(i, i);
     connectivity->SetValue(i, i);
-    id->SetValue(i, i);
+    id->SetValue(i, s);
     for (int a = 0; a < 3; ++a)
     {
-      displacement[3 * i + a] = state.Position[3 * i + a] - solid.RestPositions()[3 * i + a];
+      displacement[3 * i + a] = state.Position[3 * s + a] - solid.RestPositions()[3 * s + a];
     }
-    vonMises[i] = meshfree::VonMisesStress(&stress[6 * i]);
+    vonMises[i] = meshfree::VonMisesStress(&stress[6 * s]);
   }
   offsets->SetValue(n, n);
   verts->SetData(offsets, connectivity);
   phyxels->SetVerts(verts);
   vtkPointData* pd = phyxels->GetPointData();
   pd->AddArray(MakeArray("Displacement", 3, n, displacement.data()));
-  pd->AddArray(MakeArray("Velocity", 3, n, state.Velocity.data()));
-  pd->AddArray(MakeArray("Strain", 6, n, strain.data()));
-  pd->AddArray(MakeArray("Stress", 6, n, stress.data()));
+  pd->AddArray(MakeArray("Velocity", 3, n, state.Velocity.data() + 3 * first));
+  pd->AddArray(MakeArray("Strain", 6, n, strain.data() + 6 * first));
+  pd->AddArray(MakeArray("Stress", 6, n, stress.data() + 6 * first));
   pd->AddArray(MakeArray("VonMises", 1, n, vonMises.data()));
-  pd->AddArray(MakeArray("DetJ", 1, n, det.data()));
-  pd->AddArray(MakeArray("Mass", 1, n, solid.Masses().data()));
-  pd->AddArray(MakeArray("Volume", 1, n, solid.Volumes().data()));
+  pd->AddArray(MakeArray("DetJ", 1, n, det.data() + first));
+  pd->AddArray(MakeArray("Mass", 1, n, solid.Masses().data() + first));
+  pd->AddArray(MakeArray("Volume", 1, n, solid.Volumes().data() + first));
   pd->AddArray(id);
   pd->SetActiveScalars("VonMises");
 
-  // Surface block: every vertex follows the MLS displacement field of nearby phyxels [4.43-4.44].
+  // Surface block: every vertex follows the MLS displacement field of nearby phyxels [4.43-4.44]. An input
+  // surface is output as it came in, each rank its own piece; a built-in shape's surface is whole on piece 0.
   if (!impl.SurfacePoints.empty())
   {
     std::vector<double> deformed, surfaceDisplacement, normals;
     impl.Surface.Deform(solid, F, deformed, surfaceDisplacement);
     meshfree::VertexNormals(deformed, impl.Triangles, normals);
-    const vtkIdType nv = static_cast<vtkIdType>(deformed.size() / 3);
-    vtkNew<vtkPolyData> surface;
-    vtkNew<vtkPoints> sp;
-    sp->SetDataTypeToDouble();
-    sp->SetNumberOfPoints(nv);
-    std::copy(deformed.begin(), deformed.end(), static_cast<double*>(sp->GetVoidPointer(0)));
-    surface->SetPoints(sp);
-    vtkNew<vtkCellArray> tris;
-    const vtkIdType nt = static_cast<vtkIdType>(impl.Triangles.size() / 3);
-    vtkNew<vtkIdTypeArray> toff, tconn;
-    toff->SetNumberOfTuples(nt + 1);
-    tconn->SetNumberOfTuples(3 * nt);
-    for (vtkIdType t = 0; t <= nt; ++t)
+    std::vector<vtkIdType> pointIndex, triangles;
+    if (impl.BuiltWithInput)
     {
-      toff->SetValue(t, 3 * t);
+      pointIndex = impl.LocalToInput;
+      triangles = impl.LocalTriangles;
     }
-    for (vtkIdType c = 0; c < 3 * nt; ++c)
+    else if (vtkMeshFreePieces::OutputShare(outInfo, 1).Size() > 0)
     {
-      tconn->SetValue(c, impl.Triangles[c]);
+      pointIndex.resize(impl.SurfacePoints.size() / 3);
+      std::iota(pointIndex.begin(), pointIndex.end(), vtkIdType(0));
+      triangles.assign(impl.Triangles.begin(), impl.Triangles.end());
     }
-    tris->SetData(toff, tconn);
-    surface->SetPolys(tris);
-    surface->GetPointData()->AddArray(MakeArray("Displacement", 3, nv, surfaceDisplacement.data()));
-    auto normalArray = MakeArray("Normals", 3, nv, normals.data());
-    surface->GetPointData()->SetNormals(normalArray);
-    output->SetBlock(1, surface);
+    output->SetBlock(1, SurfaceBlock(deformed, surfaceDisplacement, normals, pointIndex, triangles));
     output->GetMetaData(1u)->Set(vtkCompositeDataSet::NAME(), "Surface");
   }
   return 1;

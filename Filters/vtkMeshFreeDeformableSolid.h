@@ -25,6 +25,14 @@
  * Displacement, Velocity, Strain and Stress (6 components xx, yy, zz, xy, yz, xz; Green strain and the stress
  * of Hooke's law), VonMises, DetJ, Mass, Volume, Id. Block 1 "Surface" (built-in shapes and the input's
  * surface): the deformed triangle mesh with Displacement and Normals.
+ *
+ * Pieces (MPI: pvbatch, pvserver): every rank simulates the whole solid (the core gives the same bits whatever the
+ * thread count) and block "Phyxels" holds the phyxels of the piece's contiguous share of [0, n) (UPDATE_PIECE_NUMBER
+ * of UPDATE_NUMBER_OF_PIECES), so each phyxel is on exactly one rank; both blocks are present on every rank, empty
+ * where there is nothing to show. The input surface, which arrives split across ranks, is gathered on every rank
+ * (collective) and put in a canonical form (points that coincide up to rounding merged, points and triangles sorted,
+ * exact duplicate triangles dropped), so the model does not depend on the number of ranks; each rank's "Surface" block is
+ * its own input piece deformed. A built-in shape's surface is whole on piece 0.
  */
 #ifndef vtkMeshFreeDeformableSolid_h
 #define vtkMeshFreeDeformableSolid_h
@@ -33,6 +41,8 @@
 #include "vtkMultiBlockDataSetAlgorithm.h"
 
 #include <memory>
+
+class vtkPolyData;
 
 class MESHFREEFILTERS_EXPORT vtkMeshFreeDeformableSolid : public vtkMultiBlockDataSetAlgorithm
 {
@@ -177,6 +187,7 @@ protected:
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int Shape = ELLIPSOID;
@@ -221,7 +232,8 @@ private:
 
   struct Internals;
   std::unique_ptr<Internals> Impl;
-  bool BuildModel(vtkInformationVector** inputVector);
+  bool BuildModel(bool fromInput);
+  void GatherInputSurface(vtkPolyData* input, bool distributed);
 };
 
 #endif

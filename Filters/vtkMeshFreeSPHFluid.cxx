@@ -13,6 +13,7 @@
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#include "Parallel/vtkMeshFreePieces.h"
 #include "SPH/SPHFluid.h"
 #include "Common/StateCache.h"
 
@@ -30,7 +31,8 @@ struct vtkMeshFreeSPHFluid::Internals
 {
   meshfree::SPHFluid Solver;
   meshfree::StateCache<meshfree::SPHState> Cache{ 16 };
-  std::string Key;         // everything the cached states depend on; a different key empties the cache
+  std::string Key;         // every property the cached states depend on; a different key empties the cache
+  std::vector<double> Obstacles; // the gathered obstacle triangles, canonical; different ones empty the cache
   bool SetupFailed = false;
   std::vector<double> Times;
 };
@@ -138,6 +140,16 @@ int vtkMeshFreeSPHFluid::RequestInformation(
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
   const double range[2] = { times.front(), times.back() };
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  // Every rank simulates the whole fluid and outputs its share of the particles (see RequestData).
+  outInfo->Set(vtkAlgorithm::CAN_HANDLE_PIECE_REQUEST(), 1);
+  return 1;
+}
+
+int vtkMeshFreeSPHFluid::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkMeshFreePieces::RequestInput(
+    outputVector->GetInformationObject(0), inputVector[0]->GetInformationObject(0));
   return 1;
 }
 
@@ -184,32 +196,41 @@ int vtkMeshFreeSPHFluid::RequestData(
   p.TimeStep = this->TimeStep;
   p.CFLNumber = this->CFLNumber;
 
-  vtkPolyData* obstacles = vtkPolyData::GetData(inputVector[0], 0);
+  // The obstacles, whole on every rank: under MPI each rank holds a piece (collective: every rank gathers, also
+  // with an empty piece). The canonical order makes the triangles, and so the simulation, the same bits whatever
+  // the number of ranks.
+  const bool distributed = vtkMeshFreePieces::IsDistributed(outInfo);
+  std::vector<double> obstacles;
+  long skipped = 0; // triangles of this rank's piece
+  if (this->GetNumberOfInputConnections(0) > 0)
+  {
+    obstacles = Triangles(vtkPolyData::GetData(inputVector[0], 0), skipped);
+    obstacles = vtkMeshFreePieces::AllGather(obstacles, distributed);
+    vtkMeshFreePieces::CanonicalTriangles(obstacles);
+  }
   std::ostringstream key;
   key << std::hexfloat << p.Dimension << ' ' << p.ParticleSpacing << ' ' << p.SmoothingLength << ' '
       << p.RestDensity << ' ' << p.GasStiffness << ' ' << this->EquationOfState << ' ' << this->KernelPair << ' '
       << p.Viscosity << ' ' << p.ArtificialViscosity << ' ' << p.SurfaceTension << ' ' << p.TimeStep << ' ' << p.CFLNumber << ' '
-      << this->OutputInterval << ' ' << (obstacles ? static_cast<long>(obstacles->GetMTime()) : -1L);
+      << this->OutputInterval;
   for (int i = 0; i < 6; ++i)
   {
     key << ' ' << p.FluidBounds[i] << ' ' << p.DomainBounds[i] << ' ' << (i < 3 ? p.Gravity[i] : 0.0);
   }
   impl.Cache.SetCapacity(static_cast<std::size_t>(this->CacheSize));
-  if (key.str() != impl.Key)
+  if (key.str() != impl.Key || obstacles != impl.Obstacles)
   {
     impl.Key = key.str();
+    impl.Obstacles = std::move(obstacles);
     impl.Cache.Clear();
     impl.SetupFailed = false;
+    if (skipped > 0)
+    {
+      vtkWarningMacro("SPH Fluid: " << skipped << " Obstacles triangles with a NaN or infinite vertex were left out");
+    }
     try
     {
-      long skipped = 0;
-      const std::vector<double> triangles = Triangles(obstacles, skipped);
-      if (skipped > 0)
-      {
-        vtkWarningMacro("SPH Fluid: " << skipped
-                                      << " Obstacles triangles with a NaN or infinite vertex were left out");
-      }
-      impl.Solver.Setup(p, triangles);
+      impl.Solver.Setup(p, impl.Obstacles);
       meshfree::SPHState initial = impl.Solver.InitialState();
       impl.Cache.Insert(0, std::move(initial));
     }
@@ -268,8 +289,12 @@ int vtkMeshFreeSPHFluid::RequestData(
                                            << " steps (set CFLNumber > 0 for adaptive steps)");
   }
 
-  // Output: one vertex per particle.
-  const vtkIdType n = static_cast<vtkIdType>(state.Size());
+  // Output: one vertex per particle of this piece's share (all of them without pieces). Every rank holds the same
+  // state, so the shares of the ranks hold each particle exactly once.
+  const vtkMeshFreePieces::Range share =
+    vtkMeshFreePieces::OutputShare(outInfo, static_cast<vtkIdType>(state.Size()));
+  const vtkIdType n = share.Size();
+  const vtkIdType first = share.Begin;
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(n);
@@ -290,11 +315,12 @@ int vtkMeshFreeSPHFluid::RequestData(
   offsets->SetNumberOfTuples(n + 1);
   for (vtkIdType i = 0; i < n; ++i)
   {
-    points->SetPoint(i, &state.Position[3 * i]);
-    velocity->SetTypedTuple(i, &state.Velocity[3 * i]);
-    density->SetValue(i, state.Density[i]);
-    pressure->SetValue(i, state.Pressure[i]);
-    ids->SetValue(i, static_cast<vtkIdType>(state.Id[i]));
+    const vtkIdType s = first + i;
+    points->SetPoint(i, &state.Position[3 * s]);
+    velocity->SetTypedTuple(i, &state.Velocity[3 * s]);
+    density->SetValue(i, state.Density[s]);
+    pressure->SetValue(i, state.Pressure[s]);
+    ids->SetValue(i, static_cast<vtkIdType>(state.Id[s]));
     connectivity->SetValue(i, i);
     offsets->SetValue(i, i);
   }
@@ -315,7 +341,7 @@ int vtkMeshFreeSPHFluid::RequestData(
     acceleration->SetNumberOfTuples(n);
     for (vtkIdType i = 0; i < n; ++i)
     {
-      acceleration->SetTypedTuple(i, &state.Acceleration[3 * i]);
+      acceleration->SetTypedTuple(i, &state.Acceleration[3 * (first + i)]);
     }
     pd->AddArray(acceleration);
   }
@@ -325,7 +351,7 @@ int vtkMeshFreeSPHFluid::RequestData(
     vtkNew<vtkIntArray> neighbors;
     neighbors->SetName("NeighborCount");
     neighbors->SetNumberOfTuples(n);
-    std::copy(counts.begin(), counts.end(), neighbors->GetPointer(0));
+    std::copy(counts.begin() + first, counts.begin() + first + n, neighbors->GetPointer(0));
     pd->AddArray(neighbors);
   }
   pd->SetActiveScalars("Pressure");

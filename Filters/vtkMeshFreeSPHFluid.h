@@ -21,6 +21,13 @@
  *
  * Output: vtkPolyData, one vertex per particle, point arrays `Velocity` (3), `Density`, `Pressure`, `Id`
  * (stable across time), and on request `Acceleration` (3) and `NeighborCount`.
+ *
+ * Pieces (MPI: pvbatch, pvserver): every rank simulates the whole fluid (the core gives the same bits whatever the
+ * thread count) and outputs only the particles whose index lies in its contiguous share of [0, n), chosen by
+ * UPDATE_PIECE_NUMBER of UPDATE_NUMBER_OF_PIECES, so that each particle is on exactly one rank. The Obstacles,
+ * which arrive split across ranks, are gathered on every rank (a collective call: every rank takes part) and put
+ * in a canonical order, so the simulation does not depend on the number of ranks. The cache is per rank and
+ * identical on all of them.
  */
 #ifndef vtkMeshFreeSPHFluid_h
 #define vtkMeshFreeSPHFluid_h
@@ -178,6 +185,7 @@ protected:
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   double FluidBounds[6] = { 0.0, 0.2, 0.0, 0.2, 0.0, 0.4 };

@@ -430,6 +430,26 @@ SPHState SPHFluid::InitialState()
   Index outside = 0;
   std::vector<Index> nearest(1);
   std::vector<double> nearestD2(1);
+  // A node outside the obstacles' bounding box cannot be inside one: only nodes within 10 spacings of that box take
+  // the nearest-sample normal test, whose answer far from an obstacle can depend on ties between coincident samples
+  // (edges, corners), i.e. on the order of the triangles. Within the 10 spacings the test is unchanged (it also drops
+  // some nodes in the plane of a face just beyond an edge, which the validated obstacle results include).
+  double obstacleBox[6] = { 0.0, -1.0, 0.0, -1.0, 0.0, -1.0 };
+  const double grow = 10.0 * dx;
+  for (std::size_t q = 0; q < this->ObstaclePosition.size(); q += 3)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      const double v = this->ObstaclePosition[q + a];
+      obstacleBox[2 * a] = q == 0 ? v - grow : std::min(obstacleBox[2 * a], v - grow);
+      obstacleBox[2 * a + 1] = q == 0 ? v + grow : std::max(obstacleBox[2 * a + 1], v + grow);
+    }
+  }
+  const bool flat = p.Dimension == 2; // y is ignored in 2D
+  const auto nearObstacles = [&obstacleBox, flat](const double* x) {
+    return x[0] >= obstacleBox[0] && x[0] <= obstacleBox[1] &&
+      (flat || (x[1] >= obstacleBox[2] && x[1] <= obstacleBox[3])) && x[2] >= obstacleBox[4] && x[2] <= obstacleBox[5];
+  };
   for (Index k = 0; k < count[2]; ++k)
   {
     for (Index j = 0; j < count[1]; ++j)
@@ -447,7 +467,8 @@ SPHState SPHFluid::InitialState()
             keep = false;
           }
         }
-        if (keep && !this->ObstaclePosition.empty() && this->ObstacleGrid.FindKNearest(x, 1, nearest, nearestD2) == 1)
+        if (keep && !this->ObstaclePosition.empty() && nearObstacles(x) &&
+          this->ObstacleGrid.FindKNearest(x, 1, nearest, nearestD2) == 1)
         {
           const double* s = &this->ObstaclePosition[3 * nearest[0]];
           const double* n = &this->ObstacleNormal[3 * nearest[0]];
