@@ -9,6 +9,7 @@
 #include <tbb/task_arena.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -98,21 +99,54 @@ const char* ParallelBackend()
 
 namespace detail
 {
+namespace
+{
+// Whether the threads pay off now, per calling thread. A loop ends only when every range handed out is done, so
+// beside busy processes it can wait for a range that a descheduled thread holds; for short loops (a few
+// milliseconds) that wait can cost more than the other threads bring. Each parallel loop compares its wall time
+// with what the calling thread alone would have taken (its own ranges' time per item, times all the items); when
+// the recent loops ran slower than that, the next 63 run on the calling thread alone, and then the threads are
+// tried again. Results do not depend on this: they never depend on the number of threads.
+struct LoopHistory
+{
+  double Ratio = 0.0; // moving average of wall time / one-thread estimate; 0: no history
+  int SerialLeft = 0;
+};
+thread_local LoopHistory History;
+thread_local bool IsCaller = false;
+using Clock = std::chrono::steady_clock;
+
+void RunSerial(Index n, RangeFunction fn, void* body)
+{
+  if (NestingDepth == 0)
+  {
+    Slot = 0;
+  }
+  ++NestingDepth;
+  fn(body, 0, n);
+  --NestingDepth;
+}
+} // namespace
+
 void ParallelRanges(Index n, Index grain, RangeFunction fn, void* body)
 {
   const int threads = MaxThreads();
   if (threads <= 1 || NestingDepth > 0)
   {
-    if (NestingDepth == 0)
-    {
-      Slot = 0;
-    }
-    ++NestingDepth;
-    fn(body, 0, n);
-    --NestingDepth;
+    RunSerial(n, fn, body);
+    return;
+  }
+  if (History.SerialLeft > 0)
+  {
+    --History.SerialLeft;
+    RunSerial(n, fn, body);
     return;
   }
   grain = std::max<Index>(1, grain);
+  double ownSeconds = 0.0;
+  Index ownItems = 0;
+  IsCaller = true;
+  const Clock::time_point start = Clock::now();
   CoreArena().Get(threads).execute([&] {
     tbb::parallel_for(
       tbb::blocked_range<Index>(0, n, static_cast<std::size_t>(grain)),
@@ -120,11 +154,32 @@ void ParallelRanges(Index n, Index grain, RangeFunction fn, void* body)
         const int slot = tbb::this_task_arena::current_thread_index();
         Slot = (slot >= 0 && slot < threads) ? slot : 0;
         ++NestingDepth;
-        fn(body, r.begin(), r.end());
+        if (IsCaller)
+        {
+          const Clock::time_point begin = Clock::now();
+          fn(body, r.begin(), r.end());
+          ownSeconds += std::chrono::duration<double>(Clock::now() - begin).count();
+          ownItems += r.end() - r.begin();
+        }
+        else
+        {
+          fn(body, r.begin(), r.end());
+        }
         --NestingDepth;
       },
       tbb::simple_partitioner()); // ranges of at most `grain` items (see Parallel.h)
   });
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  IsCaller = false;
+  if (ownItems > 0 && ownSeconds > 0.0)
+  {
+    const double ratio = wall / (ownSeconds * static_cast<double>(n) / static_cast<double>(ownItems));
+    History.Ratio = History.Ratio > 0.0 ? 0.75 * History.Ratio + 0.25 * ratio : ratio;
+    if (History.Ratio > 1.0)
+    {
+      History = LoopHistory{ 0.0, 63 };
+    }
+  }
 }
 } // namespace detail
 } // namespace meshfree
