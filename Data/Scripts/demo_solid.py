@@ -14,6 +14,8 @@ import sys
 
 from paraview import simple
 
+from demo_common import new_view
+
 CONTAINER = [-0.3, 0.3, -0.3, 0.3, 0.0, 1.0]
 SCENES = [
     dict(name="solid_octahedron", title="Octahedron, %d phyxels, box (thesis fig 4.6)", Shape="Octahedron",
@@ -49,14 +51,7 @@ def _render_scene(scene, out):
     solid = MLSDeformableSolid(ContainerBounds=CONTAINER, InitialVelocity=[0.6, 0.3, 0.0], Damping=1.0,
                                EndTime=2.0, OutputInterval=0.05, **properties)
     phyxels = simple.ExtractBlock(Input=solid, Selectors=["/Root/Phyxels"])
-    view = simple.CreateRenderView()
-    view.ViewSize = [480, 560]
-    view.OrientationAxesVisibility = 0
-    view.Background = [1, 1, 1]
-    try:
-        view.UseColorPaletteForBackground = 0
-    except AttributeError:
-        pass
+    view = new_view([480, 560])
     _container(scene["Container"], view)
     pd = simple.Show(phyxels, view)
     pd.SetRepresentationType("Point Gaussian")
