@@ -431,8 +431,8 @@ int vtkMeshFreeHalo::Exchange(vtkPointSet* local, const double region[6], double
   return status;
 }
 
-int vtkMeshFreeHalo::ExchangeForKNearest(
-  vtkPointSet* local, const double* queries, vtkIdType numberOfQueries, int k, double minimumRadius)
+int vtkMeshFreeHalo::ExchangeForKNearest(vtkPointSet* local, const double* queries, vtkIdType numberOfQueries, int k,
+  double minimumRadius, double radiusFactor)
 {
   vtkMultiProcessController* controller = this->Controller;
   double region[6];
@@ -447,6 +447,10 @@ int vtkMeshFreeHalo::ExchangeForKNearest(
   if (std::isnan(minimumRadius) || minimumRadius < 0.0)
   {
     minimumRadius = 0.0;
+  }
+  if (!(radiusFactor >= 1.0) || !std::isfinite(radiusFactor))
+  {
+    radiusFactor = 1.0;
   }
 
   // Round 1: each rank's radius is its queries' largest distance to the k-th nearest local point.
@@ -484,7 +488,7 @@ int vtkMeshFreeHalo::ExchangeForKNearest(
   };
   bool enough = true;
   const double far2 = farthestKth(grid, enough);
-  double radius = std::max(minimumRadius, enough ? std::sqrt(far2) : 0.0);
+  double radius = std::max(minimumRadius, enough ? radiusFactor * std::sqrt(far2) : 0.0);
   const double largest = vtkMeshFreeHalo::GlobalMax(controller, enough ? radius : 0.0);
   const bool anyShort = vtkMeshFreeHalo::GlobalMax(controller, enough ? 0.0 : 1.0) > 0.0;
   if (!enough)
@@ -507,7 +511,8 @@ int vtkMeshFreeHalo::ExchangeForKNearest(
   haloGrid.Build(haloXYZ, halo->GetNumberOfPoints());
   bool complete = true;
   const double need2 = farthestKth(haloGrid, complete);
-  const double need = complete ? std::sqrt(need2) : std::numeric_limits<double>::infinity();
+  const double need =
+    complete ? std::max(minimumRadius, radiusFactor * std::sqrt(need2)) : std::numeric_limits<double>::infinity();
   const bool again = vtkMeshFreeHalo::GlobalMax(controller, need > radius ? 1.0 : 0.0) > 0.0;
   if (again)
   {

@@ -86,11 +86,12 @@ public:
   /**
    * Collective. Extends `local` so that each of this rank's `numberOfQueries` query positions (interleaved
    * x, y, z) finds, among the output points, the same k nearest points as in the whole distributed cloud
-   * (all of them when the cloud has fewer), and every point within `minimumRadius`. The region is the bounding
+   * (all of them when the cloud has fewer), every point within `minimumRadius`, and every point within
+   * `radiusFactor` (>= 1) times the distance to its k-th nearest. The region is the bounding
    * box of the finite queries. One round when every rank holds at least k valid points, at most two otherwise.
    */
-  int ExchangeForKNearest(
-    vtkPointSet* local, const double* queries, vtkIdType numberOfQueries, int k, double minimumRadius = 0.0);
+  int ExchangeForKNearest(vtkPointSet* local, const double* queries, vtkIdType numberOfQueries, int k,
+    double minimumRadius = 0.0, double radiusFactor = 1.0);
 
   ///@{
   /**

@@ -5,16 +5,20 @@
 #include "vtkCharArray.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
+#include "vtkIdTypeArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
 #include "vtkMath.h"
+#include "vtkMeshFreeHalo.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
+#include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStructuredGrid.h"
 
@@ -23,16 +27,32 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numeric>
+#include <sstream>
 #include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkMeshlessApproximation);
+vtkCxxSetObjectMacro(vtkMeshlessApproximation, Controller, vtkMultiProcessController);
 
 vtkMeshlessApproximation::vtkMeshlessApproximation()
 {
   this->SetNumberOfInputPorts(2);
   const double nan = vtkMath::Nan();
   this->Center[0] = this->Center[1] = this->Center[2] = nan;
+  this->SetController(vtkMultiProcessController::GetGlobalController());
+}
+
+vtkMeshlessApproximation::~vtkMeshlessApproximation()
+{
+  this->SetController(nullptr);
+}
+
+bool vtkMeshlessApproximation::IsDistributed(vtkInformation* outInfo) const
+{
+  return vtkMeshFreeHalo::IsDistributed(this->Controller) && outInfo &&
+    outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()) &&
+    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()) > 1;
 }
 
 void vtkMeshlessApproximation::SetProbeConnection(vtkAlgorithmOutput* output)
@@ -103,7 +123,7 @@ int vtkMeshlessApproximation::RequestDataObject(
 }
 
 bool vtkMeshlessApproximation::GridGeometry(
-  vtkInformationVector** inputVector, double origin[3], double spacing[3], int dims[3])
+  vtkInformationVector** inputVector, bool distributed, double origin[3], double spacing[3], int dims[3])
 {
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0], 0);
   double bounds[6] = { 0, 0, 0, 0, 0, 0 };
@@ -113,25 +133,29 @@ bool vtkMeshlessApproximation::GridGeometry(
   {
     std::copy(this->ModelBounds, this->ModelBounds + 6, bounds);
   }
-  else if (input && input->GetNumberOfPoints() > 0)
+  else
   {
     // The bounds of the finite points (vtkPoints::GetBounds skips NaN but not Inf, and one Inf point
-    // would collapse an axis of the grid).
-    bool any = false;
-    for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
+    // would collapse an axis of the grid), over every rank's piece when distributed.
+    const vtkIdType n = input ? input->GetNumberOfPoints() : 0;
+    std::vector<double> xyz(3 * static_cast<size_t>(n));
+    for (vtkIdType i = 0; i < n; ++i)
     {
-      double x[3];
-      input->GetPoint(i, x);
-      if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
-      {
-        continue;
-      }
-      for (int a = 0; a < 3; ++a)
-      {
-        bounds[2 * a] = any ? std::min(bounds[2 * a], x[a]) : x[a];
-        bounds[2 * a + 1] = any ? std::max(bounds[2 * a + 1], x[a]) : x[a];
-      }
-      any = true;
+      input->GetPoint(i, &xyz[3 * i]);
+    }
+    double local[6];
+    vtkMeshFreeHalo::FiniteBounds(xyz.data(), n, local);
+    if (distributed)
+    {
+      vtkMeshFreeHalo::GlobalBounds(this->Controller, local, bounds);
+    }
+    else
+    {
+      std::copy(local, local + 6, bounds);
+    }
+    if (!(bounds[0] <= bounds[1] && bounds[2] <= bounds[3] && bounds[4] <= bounds[5]))
+    {
+      std::fill(bounds, bounds + 6, 0.0); // no finite point anywhere
     }
   }
   for (int a = 0; a < 3; ++a)
@@ -168,17 +192,38 @@ int vtkMeshlessApproximation::RequestInformation(
     return 1;
   }
   // The output grid depends on the input's bounds, which only its data know: bring the input up to date
-  // now (the cloud is needed whole anyway), so that the whole extent announced here is the one produced.
+  // now, so that the whole extent announced here is the one produced. Distributed, each rank brings its own
+  // piece (the one ParaView will ask for: piece = rank) and the bounds are agreed over all ranks.
+  const bool distributed = vtkMeshFreeHalo::IsDistributed(this->Controller);
   if (this->GetNumberOfInputConnections(0) > 0)
   {
     vtkAlgorithmOutput* connection = this->GetInputConnection(0, 0);
-    connection->GetProducer()->Update(connection->GetIndex());
+    if (distributed)
+    {
+      vtkNew<vtkInformation> request;
+      request->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), this->Controller->GetLocalProcessId());
+      request->Set(
+        vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), this->Controller->GetNumberOfProcesses());
+      request->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+      vtkNew<vtkInformationVector> requests;
+      requests->SetNumberOfInformationObjects(connection->GetProducer()->GetNumberOfOutputPorts());
+      requests->SetInformationObject(connection->GetIndex(), request);
+      connection->GetProducer()->Update(connection->GetIndex(), requests);
+    }
+    else
+    {
+      connection->GetProducer()->Update(connection->GetIndex());
+    }
   }
   double origin[3], spacing[3];
   int dims[3];
-  this->GridGeometry(inputVector, origin, spacing, dims);
+  this->GridGeometry(inputVector, distributed, origin, spacing, dims);
+  std::copy(origin, origin + 3, this->GridOrigin);
+  std::copy(spacing, spacing + 3, this->GridSpacing);
+  std::copy(dims, dims + 3, this->GridDimensions);
   const int extent[6] = { 0, dims[0] - 1, 0, dims[1] - 1, 0, dims[2] - 1 };
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
   if (!this->HeightField)
   {
     outInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
@@ -190,16 +235,26 @@ int vtkMeshlessApproximation::RequestInformation(
 int vtkMeshlessApproximation::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // The whole cloud is needed at every output point; the probe follows the downstream request.
+  // Serial: the whole cloud, at every output point. Distributed: the cloud's piece of this rank (the rest
+  // comes from the halo exchange). The probe follows the downstream request.
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  const bool distributed = this->IsDistributed(outInfo);
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   if (inInfo)
   {
-    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
-    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+    int piece = 0, pieces = 1;
+    if (distributed)
+    {
+      pieces = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+      piece = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+        ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+        : this->Controller->GetLocalProcessId();
+    }
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), piece);
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), pieces);
     inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
   }
   vtkInformation* probeInfo = inputVector[1]->GetInformationObject(0);
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
   if (probeInfo)
   {
     probeInfo->CopyEntry(outInfo, vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
@@ -215,26 +270,159 @@ int vtkMeshlessApproximation::RequestUpdateExtent(
 
 namespace
 {
+/// One array to approximate: its columns [Offset, Offset + Components) in the values table. Array is null on a
+/// rank whose (empty) piece lacks it.
 struct SelectedArray
 {
   vtkDataArray* Array;
   int Offset;
+  int Components;
+  std::string Name;
 };
+
+/// "name\ncomponents\n..." - the selection, comparable over ranks.
+std::string Describe(const std::vector<SelectedArray>& selected, bool volumes)
+{
+  std::ostringstream text;
+  text << (volumes ? 1 : 0) << "\n";
+  for (const SelectedArray& s : selected)
+  {
+    text << s.Name << "\n" << s.Components << "\n";
+  }
+  return text.str();
 }
+
+/// Collective. The selection of the first rank that has points (every rank must approximate the same
+/// columns); false when this rank has points and another selection.
+bool AgreeOnSelection(vtkMultiProcessController* controller, vtkIdType n, vtkPointData* pd,
+  std::vector<SelectedArray>& selected, bool& volumes)
+{
+  const int ranks = controller->GetNumberOfProcesses();
+  const int rank = controller->GetLocalProcessId();
+  const double first = ranks - vtkMeshFreeHalo::GlobalMax(controller, n > 0 ? ranks - rank : 0);
+  const int root = first < ranks ? static_cast<int>(first) : 0;
+  std::string mine = Describe(selected, volumes);
+  vtkIdType length = static_cast<vtkIdType>(mine.size());
+  controller->Broadcast(&length, 1, root);
+  std::vector<char> text(static_cast<size_t>(length) + 1, '\0');
+  if (rank == root)
+  {
+    std::copy(mine.begin(), mine.end(), text.begin());
+  }
+  controller->Broadcast(text.data(), length, root);
+  const std::string agreed(text.data(), static_cast<size_t>(length));
+  if (agreed == mine)
+  {
+    return true;
+  }
+  std::istringstream in(agreed);
+  int v = 0;
+  in >> v;
+  volumes = v != 0;
+  selected.clear();
+  std::string name;
+  int components = 0, offset = 0;
+  in.ignore();
+  while (std::getline(in, name) && in >> components)
+  {
+    in.ignore();
+    vtkDataArray* array = pd->GetArray(name.c_str());
+    selected.push_back(
+      { array && array->GetNumberOfComponents() == components ? array : nullptr, offset, components, name });
+    offset += components;
+  }
+  return n == 0;
+}
+
+/// Collective: Sum and Max over the controller's ranks for the core's distributed cloud.
+meshfree::CloudPartition Partition(vtkMultiProcessController* controller, const unsigned char* owned)
+{
+  meshfree::CloudPartition partition;
+  auto reduce = [controller](double* values, int n, int op) {
+    std::vector<double> result(static_cast<size_t>(std::max(n, 0)));
+    controller->AllReduce(values, result.data(), n, op);
+    std::copy(result.begin(), result.end(), values);
+  };
+  partition.Sum = [reduce](double* values, int n) { reduce(values, n, vtkCommunicator::SUM_OP); };
+  partition.Max = [reduce](double* values, int n) { reduce(values, n, vtkCommunicator::MAX_OP); };
+  partition.Owned = owned;
+  return partition;
+}
+
+/// The prepared cloud (fit coordinates, values, volumes) as a vertex-less vtkPolyData for the halo exchange.
+vtkSmartPointer<vtkPolyData> CloudData(const std::vector<double>& xyz, const std::vector<double>& values, int columns,
+  const std::vector<double>& volumes, vtkDataArray* globalIds)
+{
+  const vtkIdType n = static_cast<vtkIdType>(xyz.size() / 3);
+  auto cloud = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkDoubleArray> coordinates;
+  coordinates->SetNumberOfComponents(3);
+  coordinates->SetNumberOfTuples(n);
+  std::copy(xyz.begin(), xyz.end(), coordinates->GetPointer(0));
+  vtkNew<vtkPoints> points;
+  points->SetData(coordinates);
+  cloud->SetPoints(points);
+  vtkNew<vtkDoubleArray> table;
+  table->SetName("values");
+  table->SetNumberOfComponents(std::max(columns, 1));
+  table->SetNumberOfTuples(n);
+  if (columns > 0)
+  {
+    std::copy(values.begin(), values.end(), table->GetPointer(0));
+  }
+  else
+  {
+    table->Fill(0.0);
+  }
+  cloud->GetPointData()->AddArray(table);
+  if (!volumes.empty() || n == 0)
+  {
+    vtkNew<vtkDoubleArray> v;
+    v->SetName("volumes");
+    v->SetNumberOfTuples(n);
+    std::copy(volumes.begin(), volumes.end(), v->GetPointer(0));
+    cloud->GetPointData()->AddArray(v);
+  }
+  if (globalIds)
+  {
+    cloud->GetPointData()->SetGlobalIds(globalIds);
+  }
+  return cloud;
+}
+
+/// Collective. The halo the evaluation's reach asks for (ExchangeForKNearest or Exchange by radius).
+int ExchangeReach(
+  vtkMeshFreeHalo* halo, vtkPolyData* cloud, const std::vector<double>& queries, int k, double radius, double factor)
+{
+  const vtkIdType nq = static_cast<vtkIdType>(queries.size() / 3);
+  if (k > 0)
+  {
+    return halo->ExchangeForKNearest(cloud, queries.data(), nq, k, radius, factor);
+  }
+  double region[6];
+  vtkMeshFreeHalo::FiniteBounds(queries.data(), nq, region);
+  return halo->Exchange(cloud, region, radius);
+}
+} // namespace
 
 int vtkMeshlessApproximation::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0], 0);
   vtkDataSet* probe = this->GetNumberOfInputConnections(1) > 0 ? vtkDataSet::GetData(inputVector[1], 0) : nullptr;
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
   vtkDataSet* output = vtkDataSet::GetData(outputVector, 0);
   if (!input || !output)
   {
     vtkErrorMacro("Missing input point set or output.");
     return 0;
   }
+  // Distributed: every rank below takes part in every collective call, in the same order, whatever its piece.
+  const bool distributed = this->IsDistributed(outInfo);
+  vtkMultiProcessController* controller = distributed ? this->Controller : nullptr;
   const vtkIdType n = input->GetNumberOfPoints();
-  if (n == 0)
+  const vtkIdType globalN = vtkMeshFreeHalo::GlobalSum(controller, n);
+  if (globalN == 0)
   {
     vtkWarningMacro("The input has no points: every output point gets NullValue and vtkValidPointMask = 0.");
   }
@@ -256,18 +444,30 @@ int vtkMeshlessApproximation::RequestData(
     {
       continue;
     }
-    selected.push_back({ array, components });
+    selected.push_back({ array, components, array->GetNumberOfComponents(), name });
     components += array->GetNumberOfComponents();
   }
   for (const std::string& name : this->PointArrays)
   {
-    if (!inPD->GetArray(name.c_str()))
+    if (n > 0 && !inPD->GetArray(name.c_str()))
     {
       vtkWarningMacro("PointArrays names '" << name << "', which is not a numeric point array of the input.");
     }
   }
+  // SPH volumes m/rho when the cloud carries Mass and Density (as the SPH Fluid source writes).
+  vtkDataArray* mass = inPD->GetArray("Mass");
+  vtkDataArray* density = inPD->GetArray("Density");
+  bool useVolumes = this->Method == SPH && mass && density && mass->GetNumberOfComponents() == 1 &&
+    density->GetNumberOfComponents() == 1;
+  if (controller && !AgreeOnSelection(controller, n, inPD, selected, useVolumes))
+  {
+    vtkErrorMacro("This rank's piece of the cloud has other point arrays than the first rank with points: the "
+                  "arrays it lacks are taken as NaN (its points are ignored).");
+  }
+  components = selected.empty() ? 0 : selected.back().Offset + selected.back().Components;
   const int elevation = this->HeightField ? components : -1;
   const int columns = components + (this->HeightField ? 1 : 0);
+  const double nan = vtkMath::Nan();
   std::vector<double> xyz(3 * static_cast<size_t>(n)), values(static_cast<size_t>(n) * columns);
   for (vtkIdType i = 0; i < n; ++i)
   {
@@ -276,9 +476,9 @@ int vtkMeshlessApproximation::RequestData(
     double* row = &values[static_cast<size_t>(i) * columns];
     for (const SelectedArray& s : selected)
     {
-      for (int c = 0; c < s.Array->GetNumberOfComponents(); ++c)
+      for (int c = 0; c < s.Components; ++c)
       {
-        row[s.Offset + c] = s.Array->GetComponent(i, c);
+        row[s.Offset + c] = s.Array ? s.Array->GetComponent(i, c) : nan;
       }
     }
     if (this->HeightField)
@@ -287,17 +487,13 @@ int vtkMeshlessApproximation::RequestData(
       x[2] = 0.0;
     }
   }
-  // SPH volumes m/rho when the cloud carries Mass and Density (as the SPH Fluid source writes).
   std::vector<double> volumes;
-  vtkDataArray* mass = inPD->GetArray("Mass");
-  vtkDataArray* density = inPD->GetArray("Density");
-  if (this->Method == SPH && mass && density && mass->GetNumberOfComponents() == 1 &&
-    density->GetNumberOfComponents() == 1)
+  if (useVolumes)
   {
     volumes.resize(n);
     for (vtkIdType i = 0; i < n; ++i)
     {
-      volumes[i] = mass->GetComponent(i, 0) / density->GetComponent(i, 0);
+      volumes[i] = mass && density ? mass->GetComponent(i, 0) / density->GetComponent(i, 0) : nan;
     }
   }
 
@@ -326,54 +522,75 @@ int vtkMeshlessApproximation::RequestData(
   meshfree::Approximator approx;
   if (!approx.SetOptions(opts))
   {
+    // The same options on every rank: every rank stops here, before any collective call of the core.
     vtkErrorMacro("Invalid settings: " << approx.Error());
     return 0;
   }
-  approx.SetCloud(xyz.data(), n, values.data(), columns, volumes.empty() ? nullptr : volumes.data());
-  const meshfree::ApproximationReport& cloud = approx.Report();
-  if (cloud.ExcludedPoints > 0)
+  // Distributed, the first SetCloud (this rank's points) agrees on everything global; the second, after the
+  // halo exchange below, gives the evaluation its neighbours.
+  meshfree::CloudPartition partition;
+  if (controller)
   {
-    vtkWarningMacro(<< cloud.ExcludedPoints << " of " << n
+    partition = Partition(controller, nullptr);
+  }
+  approx.SetCloud(xyz.data(), n, values.data(), columns, volumes.empty() ? nullptr : volumes.data(),
+    controller ? &partition : nullptr);
+  const vtkIdType excluded = vtkMeshFreeHalo::GlobalSum(controller, approx.Report().ExcludedPoints);
+  if (excluded > 0)
+  {
+    vtkWarningMacro(<< excluded << " of " << globalN
                     << " input points have NaN/Inf coordinates or values (or a non-positive SPH volume): "
                        "they are ignored.");
   }
-  const vtkIdType valid = n - cloud.ExcludedPoints;
+  const vtkIdType valid = globalN - excluded;
   if (valid > 0 && this->SupportRadius <= 0 && this->NeighborCount > valid && this->Method != LS)
   {
     vtkWarningMacro("NeighborCount (" << this->NeighborCount << ") exceeds the " << valid
                                       << " valid input points: all of them are used.");
   }
 
-  // The output's geometry: the probe, or the grid.
-  double origin[3], spacing[3];
-  int dims[3];
+  // The output's geometry: the probe (its piece), or the grid (its requested extent).
   if (probe)
   {
     output->ShallowCopy(probe);
   }
   else
   {
-    this->GridGeometry(inputVector, origin, spacing, dims);
+    int extent[6] = { 0, this->GridDimensions[0] - 1, 0, this->GridDimensions[1] - 1, 0, this->GridDimensions[2] - 1 };
+    if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT()))
+    {
+      int requested[6];
+      outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), requested);
+      for (int a = 0; a < 3; ++a)
+      {
+        extent[2 * a] = std::max(extent[2 * a], requested[2 * a]);
+        extent[2 * a + 1] = std::min(extent[2 * a + 1], requested[2 * a + 1]);
+      }
+    }
+    const double* origin = this->GridOrigin;
+    const double* spacing = this->GridSpacing;
     if (vtkImageData* image = vtkImageData::SafeDownCast(output))
     {
       image->Initialize();
-      image->SetDimensions(dims);
-      image->SetOrigin(origin);
-      image->SetSpacing(spacing);
+      image->SetExtent(extent);
+      image->SetOrigin(this->GridOrigin);
+      image->SetSpacing(this->GridSpacing);
     }
     else if (vtkStructuredGrid* surface = vtkStructuredGrid::SafeDownCast(output))
     {
       surface->Initialize();
-      surface->SetDimensions(dims[0], dims[1], 1);
+      extent[4] = extent[5] = 0;
+      surface->SetExtent(extent);
       vtkNew<vtkPoints> points;
       points->SetDataTypeToDouble();
-      points->SetNumberOfPoints(static_cast<vtkIdType>(dims[0]) * dims[1]);
-      for (int j = 0; j < dims[1]; ++j)
+      const int ni = std::max(0, extent[1] - extent[0] + 1), nj = std::max(0, extent[3] - extent[2] + 1);
+      points->SetNumberOfPoints(static_cast<vtkIdType>(ni) * nj);
+      for (int j = 0; j < nj; ++j)
       {
-        for (int i = 0; i < dims[0]; ++i)
+        for (int i = 0; i < ni; ++i)
         {
-          points->SetPoint(static_cast<vtkIdType>(j) * dims[0] + i, origin[0] + i * spacing[0],
-            origin[1] + j * spacing[1], 0.0);
+          points->SetPoint(static_cast<vtkIdType>(j) * ni + i, origin[0] + (extent[0] + i) * spacing[0],
+            origin[1] + (extent[2] + j) * spacing[1], 0.0);
         }
       }
       surface->SetPoints(points);
@@ -381,14 +598,7 @@ int vtkMeshlessApproximation::RequestData(
   }
   const vtkIdType m = output->GetNumberOfPoints();
   std::vector<double> eval(3 * static_cast<size_t>(m));
-  double cloudBounds[6];
-  approx.Grid().GetBounds(cloudBounds);
-  double span = 0.0;
-  for (int a = 0; a < 3; ++a)
-  {
-    span = std::max(span, cloudBounds[2 * a + 1] - cloudBounds[2 * a]);
-  }
-  vtkIdType outside = 0, nonFinite = 0;
+  vtkIdType nonFinite = 0;
   for (vtkIdType i = 0; i < m; ++i)
   {
     double* x = &eval[3 * i];
@@ -397,11 +607,83 @@ int vtkMeshlessApproximation::RequestData(
     {
       x[2] = 0.0;
     }
-    if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+    nonFinite += (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2])) ? 0 : 1;
+  }
+
+  if (controller)
+  {
+    // The halo: every point of the other ranks' pieces the evaluation here reads, in one or two rounds.
+    meshfree::ApproximationReach reach;
+    approx.Reach(eval.data(), m, reach);
+    vtkDataArray* inputIds = inPD->GetGlobalIds();
+    vtkSmartPointer<vtkPolyData> cloud =
+      CloudData(xyz, values, columns, volumes, inputIds && n > 0 ? inputIds : nullptr);
+    vtkNew<vtkMeshFreeHalo> halo;
+    halo->SetController(controller);
+    if (!reach.Global)
     {
-      ++nonFinite; // masked by the evaluation
-      continue;
+      ExchangeReach(halo, cloud, reach.Queries, reach.K, reach.Radius, reach.KFactor);
+      if (reach.SecondLevel)
+      {
+        // The neighbours' own neighbourhoods (SPH volumes): every point found is a query.
+        vtkPoints* found = halo->GetOutput()->GetPoints();
+        std::vector<double> queries(3 * static_cast<size_t>(found->GetNumberOfPoints()));
+        for (vtkIdType i = 0; i < found->GetNumberOfPoints(); ++i)
+        {
+          found->GetPoint(i, &queries[3 * i]);
+        }
+        ExchangeReach(halo, cloud, queries, reach.K2, reach.Radius2, 1.0);
+      }
     }
+    // Local and halo points ordered by global id (ties break as in the serial run), own points flagged.
+    vtkPolyData* extended = reach.Global ? cloud.Get() : halo->GetOutput();
+    const vtkIdType total = extended->GetNumberOfPoints();
+    const vtkIdType owned = reach.Global ? n : halo->GetNumberOfOwnedPoints();
+    std::vector<vtkIdType> order(total);
+    std::iota(order.begin(), order.end(), vtkIdType(0));
+    if (!reach.Global)
+    {
+      const vtkIdType* ids = halo->GetGlobalIds()->GetPointer(0);
+      std::stable_sort(order.begin(), order.end(), [ids](vtkIdType a, vtkIdType b) { return ids[a] < ids[b]; });
+    }
+    vtkDataArray* table = extended->GetPointData()->GetArray("values");
+    vtkDataArray* v = extended->GetPointData()->GetArray("volumes");
+    std::vector<unsigned char> own(total);
+    std::vector<double> xyz2(3 * static_cast<size_t>(total)), values2(static_cast<size_t>(total) * columns);
+    std::vector<double> volumes2(useVolumes ? total : 0);
+    for (vtkIdType s = 0; s < total; ++s)
+    {
+      const vtkIdType id = order[s];
+      extended->GetPoint(id, &xyz2[3 * s]);
+      for (int c = 0; c < columns; ++c)
+      {
+        values2[static_cast<size_t>(s) * columns + c] = table ? table->GetComponent(id, c) : nan;
+      }
+      if (useVolumes)
+      {
+        volumes2[s] = v ? v->GetComponent(id, 0) : nan;
+      }
+      own[s] = id < owned ? 1 : 0;
+    }
+    partition.Owned = own.data();
+    approx.SetCloud(xyz2.data(), total, values2.data(), columns, useVolumes ? volumes2.data() : nullptr, &partition);
+    this->HaloPoints = total - owned;
+  }
+  else
+  {
+    this->HaloPoints = 0;
+  }
+
+  const double* cloudBounds = approx.CloudBounds();
+  double span = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    span = std::max(span, cloudBounds[2 * a + 1] - cloudBounds[2 * a]);
+  }
+  vtkIdType outside = 0;
+  for (vtkIdType i = 0; i < m; ++i)
+  {
+    const double* x = &eval[3 * i];
     for (int a = 0; a < 3; ++a)
     {
       if (x[a] < cloudBounds[2 * a] - 0.1 * span || x[a] > cloudBounds[2 * a + 1] + 0.1 * span)
@@ -466,11 +748,11 @@ int vtkMeshlessApproximation::RequestData(
   }
   for (const SelectedArray& s : selected)
   {
-    const int nc = s.Array->GetNumberOfComponents();
+    const int nc = s.Components;
     vtkNew<vtkDoubleArray> array;
-    array->SetName(s.Array->GetName());
+    array->SetName(s.Name.c_str());
     array->SetNumberOfComponents(nc);
-    for (int c = 0; c < nc; ++c)
+    for (int c = 0; c < nc && s.Array; ++c)
     {
       if (const char* cname = s.Array->GetComponentName(c))
       {
@@ -487,7 +769,7 @@ int vtkMeshlessApproximation::RequestData(
     if (this->ComputeGradients)
     {
       vtkNew<vtkDoubleArray> gradient;
-      gradient->SetName((std::string(s.Array->GetName()) + "_gradient").c_str());
+      gradient->SetName((s.Name + "_gradient").c_str());
       gradient->SetNumberOfComponents(3 * nc);
       gradient->SetNumberOfTuples(m);
       double* g = gradient->GetPointer(0);
@@ -555,7 +837,13 @@ int vtkMeshlessApproximation::RequestData(
   }
   if (!this->HeightField && !selected.empty() && !probe)
   {
-    outPD->SetActiveScalars(selected.front().Array->GetName());
+    outPD->SetActiveScalars(selected.front().Name.c_str());
+  }
+  if (controller)
+  {
+    // How many points of other ranks this rank received (field data `HaloPoints`, distributed runs only).
+    vtkMeshFreeFilterSupport::AddFieldValue(
+      output->GetFieldData(), "HaloPoints", static_cast<double>(this->HaloPoints));
   }
   return 1;
 }

@@ -25,7 +25,21 @@
  * polynomials of degree <= BasisDegree; true derivative for LS/WLS/PU-WLS/SPH), `NeighborCount` and
  * `ConditionNumber` of the equilibrated moment matrix (Diagnostics), `vtkValidPointMask` (always).
  *
- * @sa vtkPointInterpolator vtkSPHInterpolator vtkMeshFreeMLSKernel
+ * Distributed (MPI, e.g. `mpiexec -n N pvbatch` or pvserver): when the controller has several processes and
+ * the output is requested in several pieces, each rank keeps its piece of the cloud as it arrives and
+ * evaluates only its own part of the output - its piece of the probe, or its sub-extent of the grid
+ * (CAN_PRODUCE_SUB_EXTENT; the grid's bounds are agreed over all ranks). What is global is computed over all
+ * ranks (bounds, the PCA frame and intrinsic dimension, the LS moment sums, the PU-WLS lattice, the largest
+ * SPH volume), and a halo exchange (vtkMeshFreeHalo) brings each rank every cloud point its evaluation reads:
+ * within the widest support after the fallbacks (twice the radius, or the 2 x NeighborCount nearest), for
+ * PU-WLS around the lattice centres that blend into the rank's points, for SPH volumes estimated from the
+ * number density also the neighbours of those points (a second round). LS needs no halo. Halo points are
+ * ordered by global id (the GlobalIds attribute, or the index in the cloud concatenated rank by rank), so that
+ * distance ties break as in the serial run. Every rank takes part in every collective step, also with an
+ * empty piece. The output's field array `HaloPoints` says how many points this rank received. Requested as
+ * one piece (or without a controller), the filter runs serially on its input.
+ *
+ * @sa vtkPointInterpolator vtkSPHInterpolator vtkMeshFreeMLSKernel vtkMeshFreeHalo
  */
 #ifndef vtkMeshlessApproximation_h
 #define vtkMeshlessApproximation_h
@@ -35,6 +49,8 @@
 
 #include <string> // for the array selection
 #include <vector> // for the array selection
+
+class vtkMultiProcessController;
 
 class MESHFREEFILTERS_EXPORT vtkMeshlessApproximation : public vtkDataSetAlgorithm
 {
@@ -138,9 +154,20 @@ public:
   int GetNumberOfPointArrays() const { return static_cast<int>(this->PointArrays.size()); }
   ///@}
 
+  ///@{
+  /// The ranks a distributed cloud is split over (default: the global controller; none or one process:
+  /// serial).
+  void SetController(vtkMultiProcessController* controller);
+  vtkGetObjectMacro(Controller, vtkMultiProcessController);
+  ///@}
+
+  /// Points of other ranks this rank received in the last distributed run (0 when serial); also the output's
+  /// one-value field array `HaloPoints` in a distributed run.
+  vtkIdType GetNumberOfHaloPoints() const { return this->HaloPoints; }
+
 protected:
   vtkMeshlessApproximation();
-  ~vtkMeshlessApproximation() override = default;
+  ~vtkMeshlessApproximation() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
@@ -163,12 +190,23 @@ protected:
   double ModelBounds[6] = { 0, 0, 0, 0, 0, 0 };
   int SampleDimensions[3] = { 101, 101, 101 };
   std::vector<std::string> PointArrays;
+  vtkMultiProcessController* Controller = nullptr;
 
 private:
   vtkMeshlessApproximation(const vtkMeshlessApproximation&) = delete;
   void operator=(const vtkMeshlessApproximation&) = delete;
 
-  bool GridGeometry(vtkInformationVector** inputVector, double origin[3], double spacing[3], int dims[3]);
+  /// The output grid from the input's bounds (over every rank when `distributed`; collective then).
+  bool GridGeometry(
+    vtkInformationVector** inputVector, bool distributed, double origin[3], double spacing[3], int dims[3]);
+  /// Whether the cloud is split over the controller's ranks: several processes, several pieces requested.
+  bool IsDistributed(vtkInformation* outInfo) const;
+
+  // The grid announced by RequestInformation (grid mode), produced (or its piece) by RequestData.
+  double GridOrigin[3] = { 0, 0, 0 };
+  double GridSpacing[3] = { 1, 1, 1 };
+  int GridDimensions[3] = { 1, 1, 1 };
+  vtkIdType HaloPoints = 0;
 };
 
 #endif

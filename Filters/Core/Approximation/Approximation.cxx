@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace meshfree
@@ -91,8 +92,8 @@ bool Approximator::SetOptions(const ApproximationOptions& options)
   return true;
 }
 
-bool Approximator::SetCloud(
-  const double* xyz, Index n, const double* values, int components, const double* volumes)
+bool Approximator::SetCloud(const double* xyz, Index n, const double* values, int components, const double* volumes,
+  const CloudPartition* partition)
 {
   this->Rep = ApproximationReport();
   this->Err.clear();
@@ -131,33 +132,88 @@ bool Approximator::SetCloud(
   }
   this->Rep.CloudPoints = n;
   this->Rep.ExcludedPoints = excluded;
-  const bool any = this->Points.Build(this->Coordinates.data(), n);
-  this->Points.GetBounds(this->Bounds);
+  const bool anyLocal = this->Points.Build(this->Coordinates.data(), n);
+  this->Partitioned = partition != nullptr;
+  this->SumParts = partition ? partition->Sum : nullptr;
+  this->MaxParts = partition ? partition->Max : nullptr;
+  this->PartitionLSSums.clear();
 
-  // Intrinsic frame: PCA of the valid points (two-pass, centred, in double).
+  // Intrinsic frame: PCA of the valid points (two-pass, centred, in double) - of every part's own points
+  // when the cloud is distributed.
   const Index nv = this->Points.NumberOfValidPoints();
   const double* sp = this->Points.SortedPoints();
-  double c[3] = { 0, 0, 0 };
-  for (Index i = 0; i < nv; ++i)
+  const std::vector<Index>& order = this->Points.SortedOrder();
+  std::vector<Index> ownPositions; // sorted positions of this part's own valid points (partitioned only)
+  if (partition)
   {
-    for (int a = 0; a < 3; ++a)
+    ownPositions.reserve(static_cast<size_t>(nv));
+    for (Index p = 0; p < nv; ++p)
     {
-      c[a] += sp[3 * i + a];
+      if (!partition->Owned || partition->Owned[order[p]])
+      {
+        ownPositions.push_back(p);
+      }
     }
   }
+  const Index ownCount = partition ? static_cast<Index>(ownPositions.size()) : nv;
+  auto position = [&](Index i) { return partition ? ownPositions[i] : i; };
+  double c[3] = { 0, 0, 0 };
+  for (Index i = 0; i < ownCount; ++i)
+  {
+    const Index p = position(i);
+    for (int a = 0; a < 3; ++a)
+    {
+      c[a] += sp[3 * p + a];
+    }
+  }
+  double totals[4] = { c[0], c[1], c[2], static_cast<double>(ownCount) };
+  this->PartitionSum(totals, 4);
+  std::copy(totals, totals + 3, c);
+  this->GlobalValidPoints = partition ? static_cast<Index>(totals[3]) : nv;
+  const Index globalValid = this->GlobalValidPoints;
+  if (partition)
+  {
+    // Bounds of every part's own valid points (as min = -max(-x) to need one combine).
+    double b[6];
+    for (int a = 0; a < 3; ++a)
+    {
+      b[2 * a] = b[2 * a + 1] = -std::numeric_limits<double>::infinity();
+    }
+    for (Index i = 0; i < ownCount; ++i)
+    {
+      const Index p = ownPositions[i];
+      for (int a = 0; a < 3; ++a)
+      {
+        b[2 * a] = std::max(b[2 * a], -sp[3 * p + a]);
+        b[2 * a + 1] = std::max(b[2 * a + 1], sp[3 * p + a]);
+      }
+    }
+    this->PartitionMax(b, 6);
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Bounds[2 * a] = globalValid > 0 ? -b[2 * a] : 0.0;
+      this->Bounds[2 * a + 1] = globalValid > 0 ? b[2 * a + 1] : 0.0;
+    }
+  }
+  else
+  {
+    this->Points.GetBounds(this->Bounds);
+  }
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  if (nv > 0)
+  if (globalValid > 0)
   {
     for (double& v : c)
     {
-      v /= static_cast<double>(nv);
+      v /= static_cast<double>(globalValid);
     }
-    for (Index i = 0; i < nv; ++i)
+    for (Index i = 0; i < ownCount; ++i)
     {
-      const Eigen::Vector3d d(sp[3 * i] - c[0], sp[3 * i + 1] - c[1], sp[3 * i + 2] - c[2]);
+      const Index p = position(i);
+      const Eigen::Vector3d d(sp[3 * p] - c[0], sp[3 * p + 1] - c[1], sp[3 * p + 2] - c[2]);
       cov += d * d.transpose();
     }
-    cov /= static_cast<double>(nv);
+    this->PartitionSum(cov.data(), 9);
+    cov /= static_cast<double>(globalValid);
   }
   std::copy(c, c + 3, this->CloudCenter);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
@@ -178,20 +234,28 @@ bool Approximator::SetCloud(
     // 1e-16 of the largest eigenvalue, so a smaller variance ratio cannot be told from zero.)
     dim += (largest > noise && lambda(a) > 1e-13 * largest) ? 1 : 0;
   }
+  // An axis without extent (relative to the largest, as NeighborGrid::IsAxisFlat): over every part's bounds
+  // when distributed.
+  const double maxExtent = std::max(
+    { this->Bounds[1] - this->Bounds[0], this->Bounds[3] - this->Bounds[2], this->Bounds[5] - this->Bounds[4] });
+  auto axisFlat = [&](int a) {
+    return partition ? !(this->Bounds[2 * a + 1] - this->Bounds[2 * a] > 1e-10 * maxExtent)
+                     : this->Points.IsAxisFlat(a);
+  };
   this->Frame = LocalFrame();
   this->Frame.Dimension = dim;
   int axisAligned = 0;
   for (int a = 0; a < 3; ++a)
   {
-    axisAligned += this->Points.IsAxisFlat(a) ? 0 : 1;
+    axisAligned += axisFlat(a) ? 0 : 1;
   }
-  if (nv > 0 && axisAligned == dim)
+  if (globalValid > 0 && axisAligned == dim)
   {
     // Flat along coordinate axes (or 3D): use the coordinate axes themselves, in order.
     int row = 0;
     for (int a = 0; a < 3; ++a)
     {
-      if (!this->Points.IsAxisFlat(a))
+      if (!axisFlat(a))
       {
         for (int b = 0; b < 3; ++b)
         {
@@ -202,7 +266,7 @@ bool Approximator::SetCloud(
     }
     for (int a = 0; a < 3 && row < 3; ++a)
     {
-      if (this->Points.IsAxisFlat(a))
+      if (axisFlat(a))
       {
         for (int b = 0; b < 3; ++b)
         {
@@ -224,6 +288,69 @@ bool Approximator::SetCloud(
     }
   }
   this->Rep.CloudDimension = dim;
+
+  // What else is global, over every part of a distributed cloud (collective, in this order on every part).
+  if (partition)
+  {
+    if (this->Opts.Method == ApproximationMethod::LS)
+    {
+      double largest2 = 0.0;
+      for (Index p : ownPositions)
+      {
+        double d2 = 0.0;
+        for (int a = 0; a < 3; ++a)
+        {
+          d2 += (sp[3 * p + a] - this->CloudCenter[a]) * (sp[3 * p + a] - this->CloudCenter[a]);
+        }
+        largest2 = std::max(largest2, d2);
+      }
+      this->PartitionMax(&largest2, 1);
+      std::copy(this->CloudCenter, this->CloudCenter + 3, this->GlobalOrigin);
+      this->GlobalInvScale = 1.0 / (largest2 > 0.0 ? std::sqrt(largest2) : 1.0);
+      this->PartitionLSSums.resize(static_cast<size_t>(this->Opts.Degree) + 1);
+      for (int degree = this->Opts.Degree; degree >= 0; --degree)
+      {
+        std::vector<double> sums = this->LSMomentSums(degree, &ownPositions);
+        this->PartitionSum(sums.data(), static_cast<int>(sums.size()));
+        this->PartitionLSSums[degree] = std::move(sums);
+      }
+    }
+    else if (this->Opts.Method == ApproximationMethod::PUWLS)
+    {
+      double box[6] = { 0, 0, 0, 0, 0, 0 }; // -umin, umax per axis of the frame
+      for (int a = 0; a < dim; ++a)
+      {
+        box[2 * a] = box[2 * a + 1] = -std::numeric_limits<double>::infinity();
+      }
+      double origin[3];
+      this->PUOrigin(origin);
+      for (Index p : ownPositions)
+      {
+        const double dx[3] = { sp[3 * p] - origin[0], sp[3 * p + 1] - origin[1], sp[3 * p + 2] - origin[2] };
+        double u[3];
+        this->Frame.Project<3>(dx, 1.0, u);
+        for (int a = 0; a < dim; ++a)
+        {
+          box[2 * a] = std::max(box[2 * a], -u[a]);
+          box[2 * a + 1] = std::max(box[2 * a + 1], u[a]);
+        }
+      }
+      this->PartitionMax(box, 6);
+      std::copy(box, box + 6, this->PartitionBox);
+    }
+    else if (this->Opts.Method == ApproximationMethod::SPH && !this->Volumes.empty())
+    {
+      double largestVolume = 0.0;
+      for (Index i = 0; i < n; ++i)
+      {
+        const double v = this->Volumes[i];
+        largestVolume = std::isfinite(v) ? std::max(largestVolume, v) : largestVolume;
+      }
+      this->PartitionMax(&largestVolume, 1);
+      this->PartitionLargestVolume = largestVolume;
+    }
+  }
+  const bool any = partition ? globalValid > 0 && anyLocal : anyLocal;
   if (!any)
   {
     this->Err = "the cloud has no valid point";
@@ -232,12 +359,129 @@ bool Approximator::SetCloud(
   return true;
 }
 
+bool Approximator::Reach(const double* xyz, Index m, ApproximationReach& reach) const
+{
+  // The same K, radii and levels on every part, with or without points to evaluate (the exchange that
+  // follows is collective); only the queries depend on the points.
+  reach = ApproximationReach();
+  m = std::max<Index>(m, 0);
+  const int D = std::max(this->Frame.Dimension, 0);
+  const double R = this->Opts.SupportRadius;
+  const bool fixed = R > 0.0;
+  auto queriesFrom = [&](const double* points, Index count) {
+    reach.Queries.reserve(3 * static_cast<size_t>(count));
+    for (Index i = 0; i < count; ++i)
+    {
+      const double* x = points + 3 * i;
+      if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
+      {
+        reach.Queries.insert(reach.Queries.end(), x, x + 3);
+      }
+    }
+  };
+  // Each method's widest support after its fallbacks: twice the neighbours, or twice the radius.
+  switch (this->Opts.Method)
+  {
+    case ApproximationMethod::LS:
+      reach.Global = true;
+      break;
+    case ApproximationMethod::WLS:
+    {
+      double center[3];
+      for (int a = 0; a < 3; ++a)
+      {
+        center[a] = this->Opts.CenterSet ? this->Opts.Center[a] : 0.5 * (this->Bounds[2 * a] + this->Bounds[2 * a + 1]);
+      }
+      queriesFrom(center, m > 0 ? 1 : 0);
+      reach.K = fixed ? 0 : 2 * this->Opts.NeighborCount;
+      reach.Radius = fixed ? 2.0 * R : 0.0;
+      break;
+    }
+    case ApproximationMethod::MLS:
+    {
+      const int k = std::max(this->Opts.NeighborCount, kMinimumNeighborsPerTerm * BasisSize(D, this->Opts.Degree));
+      queriesFrom(xyz, m);
+      reach.K = fixed ? 0 : 2 * k;
+      reach.Radius = fixed ? 2.0 * R : 0.0;
+      break;
+    }
+    case ApproximationMethod::SPH:
+      queriesFrom(xyz, m);
+      reach.K = fixed ? 0 : 2 * this->Opts.NeighborCount;
+      reach.Radius = fixed ? 2.0 * R : 0.0;
+      // Volumes from the number density read each neighbour's own neighbourhood.
+      reach.SecondLevel = this->Volumes.empty();
+      reach.K2 = fixed ? 0 : this->Opts.NeighborCount;
+      reach.Radius2 = fixed ? R : 0.0;
+      break;
+    case ApproximationMethod::PUWLS:
+    {
+      // The lattice centres within R of the evaluation points, each fitted over its neighbours within
+      // max(SupportFactor d_k, SupportFactor R) (fixed: the support radius), doubled by the fallback.
+      double umin[3], spacing = 1.0, cover = 1.0;
+      Index counts[3];
+      this->PULattice(umin, spacing, cover, counts);
+      double box[6];
+      FiniteBox(xyz, m, box);
+      const double reach2 = (cover * (1.0 + 1e-9)) * (cover * (1.0 + 1e-9));
+      const Index nodes = counts[0] * counts[1] * counts[2];
+      for (Index node = 0; node < nodes; ++node)
+      {
+        double x[3];
+        this->PUNode(umin, spacing, counts, node, x);
+        if (BoxDistance2(box, x) <= reach2)
+        {
+          reach.Queries.insert(reach.Queries.end(), x, x + 3);
+        }
+      }
+      reach.K = fixed ? 0 : this->Opts.NeighborCount;
+      reach.Radius = 2.0 * (fixed ? R : this->Opts.SupportFactor * cover);
+      reach.KFactor = fixed ? 1.0 : 2.0 * this->Opts.SupportFactor;
+      break;
+    }
+  }
+  return m > 0;
+}
+
+void Approximator::PartitionSum(double* values, int n) const
+{
+  if (this->SumParts)
+  {
+    this->SumParts(values, n);
+  }
+}
+
+void Approximator::PartitionMax(double* values, int n) const
+{
+  if (this->MaxParts)
+  {
+    this->MaxParts(values, n);
+  }
+}
+
+void Approximator::SortById(FitScratch& s, size_t n)
+{
+  s.Candidates.resize(n);
+  for (size_t j = 0; j < n; ++j)
+  {
+    s.Candidates[j] = { s.Dist2[j], s.Ids[j] };
+  }
+  std::sort(s.Candidates.begin(), s.Candidates.end(),
+    [](const std::pair<double, Index>& a, const std::pair<double, Index>& b) { return a.second < b.second; });
+  for (size_t j = 0; j < n; ++j)
+  {
+    s.Dist2[j] = s.Candidates[j].first;
+    s.Ids[j] = s.Candidates[j].second;
+  }
+}
+
 int Approximator::Neighbors(const double x[3], int k, double radius, FitScratch& s, double& h) const
 {
   if (radius > 0.0)
   {
     this->Points.FindWithinRadius(x, radius, s.Ids, &s.Dist2);
     h = radius;
+    SortById(s, s.Ids.size());
     return static_cast<int>(s.Ids.size());
   }
   if (s.Ids.size() < static_cast<size_t>(k))
@@ -292,12 +536,14 @@ int Approximator::Neighbors(const double x[3], int k, double radius, FitScratch&
   {
     found = this->Points.FindKNearest(x, k, s.Ids.data(), s.Dist2.data());
   }
+  const double farthest = found > 0 ? std::sqrt(s.Dist2[found - 1]) : 0.0; // the k-th nearest sits last
   if (found > 0)
   {
-    s.RadiusGuess = std::sqrt(s.Dist2[found - 1]);
+    s.RadiusGuess = farthest;
     std::copy(x, x + 3, s.LastQuery);
+    SortById(s, static_cast<size_t>(found));
   }
-  h = found > 0 ? this->Opts.SupportFactor * std::sqrt(s.Dist2[found - 1]) : 0.0;
+  h = this->Opts.SupportFactor * farthest;
   if (!(h > 0.0))
   {
     // Every neighbour sits exactly at x: any positive support gives them all the weight W(0).

@@ -96,6 +96,37 @@ struct ApproximationOutput
   double* Conditions = nullptr;    // m: condition number of the equilibrated moment matrix (1 for SPH)
 };
 
+/// A cloud split over several processes (the VTK layer's MPI ranks). Sum and Max combine n values over every
+/// part, in place, with the same result on every part; Owned (one flag per point given to SetCloud, null: all)
+/// marks the part's own points, the others being copies of other parts' points (a halo) that take part in the
+/// fits but not in the cloud's global statistics. With a partition, SetCloud() computes everything global over
+/// all parts (bounds, valid count, PCA frame, the LS moment sums, the PU-WLS lattice box, the largest SPH
+/// volume) and is collective: every part must call it, in the same order, whatever its number of points.
+/// Evaluate() never communicates.
+struct CloudPartition
+{
+  std::function<void(double* values, int n)> Sum;
+  std::function<void(double* values, int n)> Max;
+  const unsigned char* Owned = nullptr;
+};
+
+/// What the evaluation at a set of points reads of the cloud (Approximator::Reach): the neighbourhoods of
+/// Queries - the K nearest points of each (K = 0: none), every point within max(Radius, KFactor x the
+/// distance to the K-th nearest). With SecondLevel, every point so found also needs its own K nearest (or
+/// those within Radius2): SPH volumes estimated from the number density. Global: the evaluation reads nothing
+/// of the cloud but its global statistics (LS).
+struct ApproximationReach
+{
+  std::vector<double> Queries;
+  int K = 0;
+  double Radius = 0.0;
+  double KFactor = 1.0;
+  bool SecondLevel = false;
+  int K2 = 0;
+  double Radius2 = 0.0;
+  bool Global = false;
+};
+
 /// What happened during the last SetCloud()/Evaluate().
 struct ApproximationReport
 {
@@ -127,8 +158,15 @@ public:
   /// The cloud: n points (x, y, z interleaved), values (n * components, row-major; may be null when
   /// components == 0) and, for SPH, optional volumes V_j = m_j / rho_j. The data are copied.
   /// Returns false (Error()) when no point is valid; Evaluate() then masks everything.
-  bool SetCloud(const double* xyz, Index n, const double* values, int components,
-    const double* volumes = nullptr);
+  /// With a partition (see CloudPartition) the cloud is this part's points plus a halo, and the call is
+  /// collective.
+  bool SetCloud(const double* xyz, Index n, const double* values, int components, const double* volumes = nullptr,
+    const CloudPartition* partition = nullptr);
+
+  /// What Evaluate() at the m points xyz will read of the cloud, for a distributed cloud's halo exchange
+  /// (after SetCloud, which may be given this part's own points only). Returns false when there is nothing
+  /// to evaluate.
+  bool Reach(const double* xyz, Index m, ApproximationReach& reach) const;
 
   /// Approximates at m points (x, y, z interleaved). Returns false when aborted or nothing could be done;
   /// every output is defined in any case (masked points get NullValue and Valid = 0).
@@ -141,6 +179,8 @@ public:
   int CloudDimension() const { return this->Frame.Dimension; }
   const LocalFrame& Frame3() const { return this->Frame; }
   const NeighborGrid& Grid() const { return this->Points; }
+  /// Bounds of the valid points (of every part's own points when distributed).
+  const double* CloudBounds() const { return this->Bounds; }
 
   /// MLS shape functions at one point (for the VTK interpolation kernel): the ids and phi of the points
   /// carrying weight. Returns false when the point is masked. Thread-safe after SetCloud() and
@@ -166,7 +206,20 @@ private:
   };
 
   bool PrepareGlobalFit();
-  bool PreparePU();
+  bool PreparePU(const double* xyz, Index m);
+  /// The PU-WLS lattice's origin: the centre of the cloud's bounds.
+  void PUOrigin(double origin[3]) const;
+  /// The PU-WLS lattice: the box (umin, umax) of the cloud in its frame relative to PUOrigin, spacing,
+  /// node counts and cover radius R.
+  void PULattice(double umin[3], double& spacing, double& cover, Index counts[3]) const;
+  /// Position of lattice node `node` (x fastest).
+  void PUNode(const double umin[3], double spacing, const Index counts[3], Index node, double x[3]) const;
+  /// Sum / Max over the parts of a distributed cloud (no-ops without a partition).
+  void PartitionSum(double* values, int n) const;
+  void PartitionMax(double* values, int n) const;
+  /// The LS moment sums of one degree (moments, then right-hand sides) over the valid points at the sorted
+  /// positions listed (null: all), about GlobalOrigin scaled by GlobalInvScale.
+  std::vector<double> LSMomentSums(int degree, const std::vector<Index>* sortedPositions) const;
   bool PrepareSPHVolumes();
   int MLSShape(const double x[3], FitScratch& s, bool gradient, bool exact, double& h,
     PointResult& result) const;
@@ -174,7 +227,12 @@ private:
   PointResult SPHPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult PUPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const;
+  /// The k nearest points of x (radius <= 0; h = SupportFactor x the k-th distance) or those within radius
+  /// (h = radius), in s.Ids / s.Dist2 ordered by index: the fits' sums then do not depend on how the
+  /// neighbours were found (warm start or not, which points a distributed part holds), only on the points.
   int Neighbors(const double x[3], int k, double radius, FitScratch& s, double& h) const;
+  /// Orders the first n of s.Ids / s.Dist2 by index.
+  static void SortById(FitScratch& s, size_t n);
   /// Keeps those of the n neighbours s.Ids/s.Dist2 of x with a positive, finite weight W(r / h)^2, packed at
   /// the front of s.Ids and s.Weights, with their local coordinates (x_j - x) / h in the frame in s.Xi;
   /// returns how many. s must hold room for n (FitScratch::Reserve).
@@ -206,6 +264,14 @@ private:
   int GlobalNeighbors = 0;
   double GlobalCondition = 0.0;
   std::unique_ptr<PUData> PU;
+  // A distributed cloud (SetCloud with a partition): the combine functions, the global valid count, the LS
+  // moment sums per degree, the PU-WLS box and the largest given SPH volume, all over every part.
+  bool Partitioned = false;
+  std::function<void(double*, int)> SumParts, MaxParts;
+  Index GlobalValidPoints = 0;
+  std::vector<std::vector<double>> PartitionLSSums;
+  double PartitionBox[6] = { 0, 0, 0, 0, 0, 0 };
+  double PartitionLargestVolume = 0.0;
 };
 
 } // namespace meshfree

@@ -24,7 +24,7 @@ bool Approximator::PrepareShapeFunctions()
     this->Err = e.what();
     return false;
   }
-  return this->Points.NumberOfValidPoints() > 0;
+  return this->GlobalValidPoints > 0; // a part of a distributed cloud may hold none itself
 }
 
 bool Approximator::PrepareGlobalFit()
@@ -33,67 +33,49 @@ bool Approximator::PrepareGlobalFit()
   const int C = this->NumberOfComponents;
   const Index nv = this->Points.NumberOfValidPoints();
   const double* sp = this->Points.SortedPoints();
-  const Index* order = this->Points.SortedOrder().data();
   this->GlobalCoefficients.assign(static_cast<size_t>(kMaxBasisSize) * C, 0.0);
   this->GlobalDegree = -1;
   if (this->Opts.Method == ApproximationMethod::LS)
   {
-    // Shift to the centroid, scale by the largest distance from it (3.19-3.20).
+    // Shift to the centroid, scale by the largest distance from it (3.19-3.20). A distributed cloud has both,
+    // and the moment sums, from SetCloud (over every part).
     std::copy(this->CloudCenter, this->CloudCenter + 3, this->GlobalOrigin);
-    double largest2 = 0.0;
-    for (Index i = 0; i < nv; ++i)
+    if (!this->Partitioned)
     {
-      double d2 = 0.0;
-      for (int a = 0; a < 3; ++a)
+      double largest2 = 0.0;
+      for (Index i = 0; i < nv; ++i)
       {
-        d2 += (sp[3 * i + a] - this->GlobalOrigin[a]) * (sp[3 * i + a] - this->GlobalOrigin[a]);
+        double d2 = 0.0;
+        for (int a = 0; a < 3; ++a)
+        {
+          d2 += (sp[3 * i + a] - this->GlobalOrigin[a]) * (sp[3 * i + a] - this->GlobalOrigin[a]);
+        }
+        largest2 = std::max(largest2, d2);
       }
-      largest2 = std::max(largest2, d2);
+      const double scale = largest2 > 0.0 ? std::sqrt(largest2) : 1.0;
+      this->GlobalInvScale = 1.0 / scale;
     }
-    const double scale = largest2 > 0.0 ? std::sqrt(largest2) : 1.0;
-    this->GlobalInvScale = 1.0 / scale;
+    const Index globalValid = this->GlobalValidPoints;
     for (int degree = this->Opts.Degree; degree >= 0; --degree)
     {
       const int q = BasisSize(D, D > 0 ? degree : 0);
-      // The sums over the points, in fixed blocks of points added in block order: the same whatever the number
-      // of threads (one block, as serial as before, up to 65536 points).
-      const size_t qq = static_cast<size_t>(q) * q, size = qq + static_cast<size_t>(q) * C;
-      std::vector<double> sums = ParallelReduce(nv, 65536, std::vector<double>(size, 0.0),
-        [&](Index begin, Index end) {
-          std::vector<double> part(size, 0.0);
-          constexpr Index block = 256;
-          double xi[3 * block];
-          for (Index b = begin; b < end; b += block)
-          {
-            const Index e = std::min(end, b + block);
-            for (Index i = b; i < e; ++i)
-            {
-              const double dx[3] = { sp[3 * i] - this->GlobalOrigin[0], sp[3 * i + 1] - this->GlobalOrigin[1],
-                sp[3 * i + 2] - this->GlobalOrigin[2] };
-              double* x = xi + 3 * (i - b);
-              x[0] = x[1] = x[2] = 0.0;
-              this->Frame.Project<3>(dx, this->GlobalInvScale, x);
-            }
-            AccumulateFit(D, degree, xi, nullptr, static_cast<int>(e - b), order + b, this->Values.data(), C,
-              part.data(), part.data() + qq);
-          }
-          return part;
-        },
-        [](std::vector<double> total, const std::vector<double>& part) {
-          for (size_t a = 0; a < part.size(); ++a)
-          {
-            total[a] += part[a];
-          }
-          return total;
-        });
+      std::vector<double> sums;
+      if (this->Partitioned && static_cast<size_t>(degree) < this->PartitionLSSums.size())
+      {
+        sums = this->PartitionLSSums[degree];
+      }
+      else
+      {
+        sums = this->LSMomentSums(degree, nullptr);
+      }
       double* moment = sums.data(); // the moments, then the right-hand sides
-      const double* rhs = sums.data() + qq;
-      if (nv >= q &&
-        SolveAccumulatedFit(D, degree, moment, rhs, C, this->Opts.Diagnostics,
-          this->GlobalCoefficients.data(), this->GlobalCondition))
+      const double* rhs = sums.data() + static_cast<size_t>(q) * q;
+      if (globalValid >= q &&
+        SolveAccumulatedFit(
+          D, degree, moment, rhs, C, this->Opts.Diagnostics, this->GlobalCoefficients.data(), this->GlobalCondition))
       {
         this->GlobalDegree = degree;
-        this->GlobalNeighbors = static_cast<int>(std::min<Index>(nv, 2147483647));
+        this->GlobalNeighbors = static_cast<int>(std::min<Index>(globalValid, 2147483647));
         break;
       }
     }
@@ -139,6 +121,51 @@ bool Approximator::PrepareGlobalFit()
     this->Err = "the WLS fit around the centre is degenerate even after the fallbacks";
   }
   return this->GlobalDegree >= 0;
+}
+
+std::vector<double> Approximator::LSMomentSums(int degree, const std::vector<Index>* positions) const
+{
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const int q = BasisSize(D, D > 0 ? degree : 0);
+  const double* sp = this->Points.SortedPoints();
+  const Index* order = this->Points.SortedOrder().data();
+  const Index count = positions ? static_cast<Index>(positions->size()) : this->Points.NumberOfValidPoints();
+  // The sums over the points, in fixed blocks of points added in block order: the same whatever the number of
+  // threads (one block, as serial as before, up to 65536 points).
+  const size_t qq = static_cast<size_t>(q) * q, size = qq + static_cast<size_t>(q) * C;
+  return ParallelReduce(
+    count, 65536, std::vector<double>(size, 0.0),
+    [&](Index begin, Index end) {
+      std::vector<double> part(size, 0.0);
+      constexpr Index block = 256;
+      double xi[3 * block];
+      Index ids[block];
+      for (Index b = begin; b < end; b += block)
+      {
+        const Index e = std::min(end, b + block);
+        for (Index i = b; i < e; ++i)
+        {
+          const Index p = positions ? (*positions)[i] : i;
+          const double dx[3] = { sp[3 * p] - this->GlobalOrigin[0], sp[3 * p + 1] - this->GlobalOrigin[1],
+            sp[3 * p + 2] - this->GlobalOrigin[2] };
+          double* x = xi + 3 * (i - b);
+          x[0] = x[1] = x[2] = 0.0;
+          this->Frame.Project<3>(dx, this->GlobalInvScale, x);
+          ids[i - b] = order[p];
+        }
+        AccumulateFit(
+          D, degree, xi, nullptr, static_cast<int>(e - b), ids, this->Values.data(), C, part.data(), part.data() + qq);
+      }
+      return part;
+    },
+    [](std::vector<double> total, const std::vector<double>& part) {
+      for (size_t a = 0; a < part.size(); ++a)
+      {
+        total[a] += part[a];
+      }
+      return total;
+    });
 }
 
 Approximator::PointResult Approximator::GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const
@@ -227,7 +254,7 @@ bool Approximator::Evaluate(
       ready = this->PrepareGlobalFit();
       break;
     case ApproximationMethod::PUWLS:
-      ready = this->PreparePU();
+      ready = this->PreparePU(xyz, m);
       break;
     case ApproximationMethod::SPH:
       ready = this->PrepareSPHVolumes();

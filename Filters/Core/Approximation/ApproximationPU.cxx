@@ -11,27 +11,40 @@
 namespace meshfree
 {
 
-bool Approximator::PreparePU()
+void Approximator::PUOrigin(double origin[3]) const
 {
-  this->PU.reset(new PUData);
-  PUData& pu = *this->PU;
+  // The centre of the bounds, not the centroid: min and max do not depend on the order the points are
+  // visited in (nor on how a distributed cloud is split), a sum does in its last bits.
+  for (int a = 0; a < 3; ++a)
+  {
+    origin[a] = 0.5 * (this->Bounds[2 * a] + this->Bounds[2 * a + 1]);
+  }
+}
+
+void Approximator::PULattice(double umin[3], double& spacing, double& cover, Index counts[3]) const
+{
   const int D = this->Frame.Dimension;
-  const int C = this->NumberOfComponents;
-  const Index nv = this->Points.NumberOfValidPoints();
+  const Index nv = this->GlobalValidPoints;
   const double* sp = this->Points.SortedPoints();
   const int k = this->Opts.NeighborCount;
   constexpr double pi = 3.141592653589793238462643383279502884;
 
-  double umin[3] = { 0, 0, 0 }, umax[3] = { 0, 0, 0 };
+  double umax[3] = { 0, 0, 0 }, origin[3];
+  this->PUOrigin(origin);
+  for (int a = 0; a < 3; ++a)
+  {
+    umin[a] = umax[a] = 0.0;
+    counts[a] = 1;
+  }
   for (int a = 0; a < D; ++a)
   {
-    umin[a] = std::numeric_limits<double>::infinity();
-    umax[a] = -umin[a];
+    // A distributed cloud's box comes from SetCloud (over every part).
+    umin[a] = this->Partitioned ? -this->PartitionBox[2 * a] : std::numeric_limits<double>::infinity();
+    umax[a] = this->Partitioned ? this->PartitionBox[2 * a + 1] : -std::numeric_limits<double>::infinity();
   }
-  for (Index i = 0; i < nv; ++i)
+  for (Index i = 0; i < (this->Partitioned ? 0 : this->Points.NumberOfValidPoints()); ++i)
   {
-    const double dx[3] = { sp[3 * i] - this->CloudCenter[0], sp[3 * i + 1] - this->CloudCenter[1],
-      sp[3 * i + 2] - this->CloudCenter[2] };
+    const double dx[3] = { sp[3 * i] - origin[0], sp[3 * i + 1] - origin[1], sp[3 * i + 2] - origin[2] };
     double u[3];
     this->Frame.Project<3>(dx, 1.0, u);
     for (int a = 0; a < D; ++a)
@@ -40,9 +53,8 @@ bool Approximator::PreparePU()
       umax[a] = std::max(umax[a], u[a]);
     }
   }
-  double spacing = 1.0;
-  double cover = 1.0;
-  Index counts[3] = { 1, 1, 1 };
+  spacing = 1.0;
+  cover = 1.0;
   if (D > 0)
   {
     if (this->Opts.SupportRadius > 0.0)
@@ -92,6 +104,35 @@ bool Approximator::PreparePU()
       cover = spacing * std::sqrt(static_cast<double>(D));
     }
   }
+}
+
+void Approximator::PUNode(const double umin[3], double spacing, const Index counts[3], Index node, double x[3]) const
+{
+  const Index index[3] = { node % counts[0], (node / counts[0]) % counts[1], node / (counts[0] * counts[1]) };
+  this->PUOrigin(x);
+  for (int a = 0; a < this->Frame.Dimension; ++a)
+  {
+    const double u = umin[a] + static_cast<double>(index[a]) * spacing;
+    for (int b = 0; b < 3; ++b)
+    {
+      x[b] += u * this->Frame.Axes[a][b];
+    }
+  }
+}
+
+bool Approximator::PreparePU(const double* xyz, Index m)
+{
+  this->PU.reset(new PUData);
+  PUData& pu = *this->PU;
+  const int C = this->NumberOfComponents;
+  const int k = this->Opts.NeighborCount;
+  double umin[3], spacing = 1.0, cover = 1.0;
+  Index counts[3];
+  this->PULattice(umin, spacing, cover, counts);
+  // Only the centres within R of the evaluation points' box can blend into them: the others are not fitted.
+  double box[6];
+  FiniteBox(xyz, m, box);
+  const double reach2 = (cover * (1.0 + 1e-9)) * (cover * (1.0 + 1e-9));
   pu.CoverRadius = cover;
   const Index nodes = counts[0] * counts[1] * counts[2];
   const size_t stride = static_cast<size_t>(kMaxBasisSize) * C;
@@ -103,17 +144,13 @@ bool Approximator::PreparePU()
     FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
     for (Index node = begin; node < end; ++node)
     {
-      const Index index[3] = { node % counts[0], (node / counts[0]) % counts[1], node / (counts[0] * counts[1]) };
-      double x[3] = { this->CloudCenter[0], this->CloudCenter[1], this->CloudCenter[2] };
-      for (int a = 0; a < D; ++a)
-      {
-        const double u = umin[a] + static_cast<double>(index[a]) * spacing;
-        for (int b = 0; b < 3; ++b)
-        {
-          x[b] += u * this->Frame.Axes[a][b];
-        }
-      }
+      double x[3];
+      this->PUNode(umin, spacing, counts, node, x);
       std::copy(x, x + 3, &centers[3 * node]);
+      if (BoxDistance2(box, x) > reach2)
+      {
+        continue;
+      }
       double h = 0.0;
       if (this->Opts.SupportRadius > 0.0)
       {
@@ -127,6 +164,7 @@ bool Approximator::PreparePU()
       for (int attempt = 0; attempt < 2 && degrees[node] < 0; ++attempt, h *= 2.0)
       {
         this->Points.FindWithinRadius(x, h, s.Ids, &s.Dist2);
+        SortById(s, s.Ids.size());
         const int n = static_cast<int>(s.Ids.size());
         if (attempt == 0)
         {
@@ -186,6 +224,7 @@ Approximator::PointResult Approximator::PUPoint(
   const size_t stride = static_cast<size_t>(kMaxBasisSize) * C;
   const double R = pu.CoverRadius;
   pu.CenterGrid.FindWithinRadius(x, R, s.Ids, &s.Dist2);
+  SortById(s, s.Ids.size()); // centres in lattice order, whichever were fitted
   // Work: blended values (C), blended local gradients (3C), one centre's values (C) and gradients (3C).
   s.Work.resize(8 * static_cast<size_t>(C) + 8);
   double* sumValues = s.Work.data();

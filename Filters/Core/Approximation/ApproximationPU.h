@@ -5,6 +5,9 @@
 
 #include "Approximation/Approximation.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 namespace meshfree
@@ -20,6 +23,43 @@ struct Approximator::PUData
   std::vector<double> Coefficients; // kMaxBasisSize * C per centre
   NeighborGrid CenterGrid;
 };
+/// Bounds of the finite positions among m interleaved x, y, z (min > max when none is).
+inline void FiniteBox(const double* xyz, Index m, double box[6])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    box[2 * a] = std::numeric_limits<double>::infinity();
+    box[2 * a + 1] = -std::numeric_limits<double>::infinity();
+  }
+  for (Index i = 0; i < m; ++i)
+  {
+    const double* x = xyz + 3 * i;
+    if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        box[2 * a] = std::min(box[2 * a], x[a]);
+        box[2 * a + 1] = std::max(box[2 * a + 1], x[a]);
+      }
+    }
+  }
+}
+
+/// Squared distance from x to a box (+inf for an empty box).
+inline double BoxDistance2(const double box[6], const double x[3])
+{
+  double d2 = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!(box[2 * a] <= box[2 * a + 1]))
+    {
+      return std::numeric_limits<double>::infinity();
+    }
+    const double d = x[a] < box[2 * a] ? box[2 * a] - x[a] : (x[a] > box[2 * a + 1] ? x[a] - box[2 * a + 1] : 0.0);
+    d2 += d * d;
+  }
+  return d2;
+}
 } // namespace meshfree
 
 #endif

@@ -22,6 +22,10 @@ bool Approximator::PrepareSPHVolumes()
     {
       largest = std::isfinite(v) ? std::max(largest, v) : largest;
     }
+    if (this->Partitioned)
+    {
+      largest = this->PartitionLargestVolume; // over every part (SetCloud)
+    }
     this->SphUnitLength = largest > 0.0 ? std::pow(largest, 1.0 / dim) : 1.0;
     this->SphVolumes.resize(this->Volumes.size());
     for (size_t i = 0; i < this->Volumes.size(); ++i)
