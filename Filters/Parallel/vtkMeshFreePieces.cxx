@@ -83,7 +83,8 @@ std::vector<double> AllGather(const std::vector<double>& local, bool distributed
   return AllGather(distributed ? vtkMultiProcessController::GetGlobalController() : nullptr, local, offset);
 }
 
-std::vector<double> AllGather(vtkMultiProcessController* controller, const std::vector<double>& local, vtkIdType* offset)
+std::vector<double> AllGather(
+  vtkMultiProcessController* controller, const std::vector<double>& local, vtkIdType* offset)
 {
   if (offset)
   {
@@ -130,9 +131,8 @@ GatheredCloud GatherCloud(
   }
   // The input's global ids, when every rank with points has them (a MAX over "has points but no ids").
   vtkDataArray* ids = local ? local->GetPointData()->GetGlobalIds() : nullptr;
-  if (ids &&
-    (ids->GetNumberOfComponents() != 1 || ids->GetDataType() == VTK_FLOAT || ids->GetDataType() == VTK_DOUBLE ||
-      ids->GetNumberOfTuples() != n))
+  if (ids && (ids->GetNumberOfComponents() != 1 || ids->GetDataType() == VTK_FLOAT ||
+               ids->GetDataType() == VTK_DOUBLE || ids->GetNumberOfTuples() != n))
   {
     ids = nullptr;
   }
@@ -162,7 +162,8 @@ GatheredCloud GatherCloud(
   cloud.Own.resize(static_cast<size_t>(n));
   for (vtkIdType s = 0; s < cloud.Count; ++s)
   {
-    std::copy_n(&all[static_cast<size_t>(order[s]) * (width + 1) + 1], width, &cloud.Rows[static_cast<size_t>(s) * width]);
+    std::copy_n(
+      &all[static_cast<size_t>(order[s]) * (width + 1) + 1], width, &cloud.Rows[static_cast<size_t>(s) * width]);
     if (order[s] >= offset && order[s] < offset + n)
     {
       cloud.Own[order[s] - offset] = s;
