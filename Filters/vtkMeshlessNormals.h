@@ -25,6 +25,18 @@
  * Field data: `NoiseEstimate` (spread of the points about the surface), `SupportRadius` (median
  * neighbourhood radius), `AmbiguousOrientations` (points with OrientationConfidence < 0.5).
  *
+ * Under MPI (pvbatch, pvserver: each rank's input is piece = rank of N) each rank outputs its own points, in the
+ * order of its piece, with the arrays and field data that a serial run gives them, bit for bit. The estimation
+ * has global steps: the propagated orientation (a minimum spanning tree over the whole cloud's neighbour graph,
+ * then each connected piece turned outward as a whole), the noise and scale estimate (a sample of the whole
+ * cloud), the outlier threshold and fit supports (medians over all points) and the merging of duplicates. So that
+ * every one of them is the serial one, the filter is not distributed yet: every rank gathers the whole cloud
+ * (coordinates, and the input's Normals when they orient the result: 24 or 48 bytes per point; an all-gather,
+ * in which ranks with empty pieces take part), puts it in global id order (the GlobalIds attribute, else the
+ * rank-by-rank concatenation, the serial order of a cloud split by index) and runs the serial estimation on
+ * it, keeping its own points' results. Each rank thus spends the serial run's time and memory. An input that every
+ * rank holds whole (piece 0 of 1 on each rank) is computed locally, without communication.
+ *
  * @sa vtkMeshlessSurface vtkPCANormalEstimation
  */
 #ifndef vtkMeshlessNormals_h

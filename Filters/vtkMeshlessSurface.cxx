@@ -3,11 +3,16 @@
 
 #include "vtkCellArray.h"
 #include "vtkCharArray.h"
+#include "vtkCommunicator.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
+#include "vtkIdList.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMeshFreeHalo.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -16,6 +21,8 @@
 #include "vtkPolyData.h"
 #include "vtkStringArray.h"
 #include "vtkTypeInt64Array.h"
+
+#include "Parallel/vtkMeshFreePieces.h"
 
 #include "Approximation/Approximation.h"
 #include "Surface/MeshTopology.h"
@@ -32,6 +39,7 @@
 vtkStandardNewMacro(vtkMeshlessSurface);
 
 /// The input as the core takes it: interleaved doubles, optional normals and SPH volumes.
+/// Under MPI, the whole cloud (every rank's piece, in global id order).
 struct vtkMeshlessSurface::Cloud
 {
   vtkIdType Count = 0;
@@ -39,6 +47,18 @@ struct vtkMeshlessSurface::Cloud
   std::vector<double> Normals; // empty: none given (or not wanted)
   std::vector<double> Volumes; // empty: none (SPH without Mass and Density)
   vtkIdType InvalidVolumes = 0;
+  /// The other numeric point arrays, approximated at the vertices: their layout, and their values side by side
+  /// in one row-major table (every component, as double).
+  struct Array
+  {
+    std::string Name;
+    int Components = 0;
+    std::vector<std::string> ComponentNames; // empty strings: unnamed
+  };
+  std::vector<Array> Arrays;
+  int Columns = 0;
+  std::vector<double> Values;
+  std::string ActiveScalars;
 };
 
 /// What the core returned, and what the VTK layer added.
@@ -89,6 +109,36 @@ void WrapMesh(const meshfree::SurfaceMesh& mesh, vtkPolyData* output)
   output->SetPolys(polys);
   output->GetPointData()->SetNormals(normals);
 }
+
+/// Triangles [begin, end) of `mesh` with the vertices they use, in the order of their indices in `mesh`; `kept`
+/// receives those indices.
+meshfree::SurfaceMesh TriangleShare(const meshfree::SurfaceMesh& mesh, vtkIdType begin, vtkIdType end, vtkIdList* kept)
+{
+  meshfree::SurfaceMesh share;
+  std::vector<meshfree::Index> index(static_cast<size_t>(mesh.NumberOfPoints()), -1);
+  for (vtkIdType c = 3 * begin; c < 3 * end; ++c)
+  {
+    index[mesh.Triangles[c]] = 0;
+  }
+  meshfree::Index used = 0;
+  for (size_t v = 0; v < index.size(); ++v)
+  {
+    if (index[v] < 0)
+    {
+      continue;
+    }
+    index[v] = used++;
+    kept->InsertNextId(static_cast<vtkIdType>(v));
+    share.Points.insert(share.Points.end(), &mesh.Points[3 * v], &mesh.Points[3 * v] + 3);
+    share.Normals.insert(share.Normals.end(), &mesh.Normals[3 * v], &mesh.Normals[3 * v] + 3);
+  }
+  share.Triangles.reserve(static_cast<size_t>(3 * (end - begin)));
+  for (vtkIdType c = 3 * begin; c < 3 * end; ++c)
+  {
+    share.Triangles.push_back(index[mesh.Triangles[c]]);
+  }
+  return share;
+}
 } // namespace
 
 vtkMeshlessSurface::vtkMeshlessSurface() = default;
@@ -99,46 +149,167 @@ int vtkMeshlessSurface::FillInputPortInformation(int, vtkInformation* info)
   return 1;
 }
 
-void vtkMeshlessSurface::GatherInput(vtkPointSet* input, Cloud& cloud)
+void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessController* controller, Cloud& cloud)
 {
+  // Under MPI every rank takes part in every collective call here, with an empty piece too, and agrees on what the
+  // rows hold: an array is used when every rank with points has it.
   const vtkIdType n = input->GetNumberOfPoints();
-  cloud.Count = n;
-  cloud.Points.resize(3 * static_cast<size_t>(n));
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    input->GetPoint(i, &cloud.Points[3 * i]);
-  }
+  const bool distributed = controller != nullptr;
+  const bool reporter = !distributed || controller->GetLocalProcessId() == 0;
+  auto agreed = [controller, n](bool has) {
+    if (!controller)
+    {
+      return has;
+    }
+    const bool some = vtkMeshFreeHalo::GlobalMax(controller, n > 0 && has ? 1.0 : 0.0) > 0;
+    const bool lacking = vtkMeshFreeHalo::GlobalMax(controller, n > 0 && !has ? 1.0 : 0.0) > 0;
+    return some && !lacking;
+  };
   vtkPointData* pd = input->GetPointData();
+  vtkDataArray* normals = nullptr;
   if (this->Method != SPH && this->UseInputNormals)
   {
-    if (vtkDataArray* normals = pd->GetArray(kNormals))
+    normals = pd->GetArray(kNormals);
+    if (normals && normals->GetNumberOfComponents() != 3)
     {
-      if (normals->GetNumberOfComponents() == 3)
-      {
-        cloud.Normals.resize(3 * static_cast<size_t>(n));
-        for (vtkIdType i = 0; i < n; ++i)
-        {
-          normals->GetTuple(i, &cloud.Normals[3 * i]);
-        }
-      }
-      else
-      {
-        vtkWarningMacro("The input's point array Normals has " << normals->GetNumberOfComponents()
-                                                               << " components, not 3: normals are estimated instead.");
-      }
+      vtkWarningMacro("The input's point array Normals has " << normals->GetNumberOfComponents()
+                                                             << " components, not 3: normals are estimated instead.");
+      normals = nullptr;
     }
   }
   vtkDataArray* mass = pd->GetArray("Mass");
   vtkDataArray* density = pd->GetArray("Density");
-  if (this->Method == SPH && mass && density && mass->GetNumberOfComponents() == 1 &&
-    density->GetNumberOfComponents() == 1)
+  if (!(this->Method == SPH && mass && density && mass->GetNumberOfComponents() == 1 &&
+        density->GetNumberOfComponents() == 1))
   {
-    cloud.Volumes.resize(n);
-    for (vtkIdType i = 0; i < n; ++i)
+    mass = density = nullptr;
+  }
+  const bool useNormals = agreed(normals != nullptr);
+  const bool useVolumes = agreed(mass != nullptr);
+
+  // Every other numeric point array, approximated at the vertices; its layout, as text to compare over ranks.
+  std::string layout;
+  for (int a = 0; a < pd->GetNumberOfArrays(); ++a)
+  {
+    vtkDataArray* array = pd->GetArray(a);
+    const char* name = array ? array->GetName() : nullptr;
+    if (!name || std::strcmp(name, kNormals) == 0 || std::strcmp(name, kValidMask) == 0 ||
+      std::strcmp(name, vtkDataSetAttributes::GhostArrayName()) == 0)
     {
-      cloud.Volumes[i] = mass->GetComponent(i, 0) / density->GetComponent(i, 0);
+      continue;
+    }
+    layout += std::string(name) + '\x1f' + std::to_string(array->GetNumberOfComponents());
+    for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+    {
+      const char* componentName = array->GetComponentName(c);
+      layout += '\x1f' + std::string(componentName ? componentName : "");
+    }
+    layout += '\x1e';
+  }
+  if (distributed)
+  {
+    // The layout of the first rank with points, checked against every other rank with points.
+    const int size = controller->GetNumberOfProcesses();
+    const int mine = n > 0 ? controller->GetLocalProcessId() : size;
+    int root = mine;
+    controller->AllReduce(&mine, &root, 1, vtkCommunicator::MIN_OP);
+    if (root < size)
+    {
+      vtkIdType length = static_cast<vtkIdType>(layout.size());
+      controller->Broadcast(&length, 1, root);
+      std::vector<char> text(layout.begin(), layout.end());
+      text.resize(static_cast<size_t>(length) + 1, '\0');
+      controller->Broadcast(text.data(), length + 1, root);
+      const std::string agreedLayout(text.data(), static_cast<size_t>(length));
+      if (vtkMeshFreeHalo::GlobalMax(controller, n > 0 && layout != agreedLayout ? 1.0 : 0.0) > 0)
+      {
+        if (reporter)
+        {
+          vtkWarningMacro("The ranks' pieces have different point arrays: none is approximated at the vertices.");
+        }
+        layout.clear();
+      }
+      else
+      {
+        layout = agreedLayout;
+      }
+    }
+  }
+  // Parse the (agreed) layout: a rank with an empty piece may have no arrays at all.
+  cloud.Arrays.clear();
+  cloud.Columns = 0;
+  for (size_t begin = 0; begin < layout.size();)
+  {
+    const size_t end = layout.find('\x1e', begin);
+    std::vector<std::string> fields;
+    for (size_t f = begin; f <= end;)
+    {
+      const size_t next = std::min(layout.find('\x1f', f), end);
+      fields.push_back(layout.substr(f, next - f));
+      f = next + 1;
+    }
+    Cloud::Array array;
+    array.Name = fields[0];
+    array.Components = std::stoi(fields[1]);
+    array.ComponentNames.assign(fields.begin() + 2, fields.end());
+    cloud.Columns += array.Components;
+    cloud.Arrays.push_back(array);
+    begin = end + 1;
+  }
+  vtkDataArray* scalars = pd->GetScalars();
+  cloud.ActiveScalars = scalars && scalars->GetName() ? scalars->GetName() : "";
+
+  // One row per point: coordinates, normals, volume, the arrays' values; gathered whole under MPI.
+  const int width = 3 + (useNormals ? 3 : 0) + (useVolumes ? 1 : 0) + cloud.Columns;
+  std::vector<double> rows(static_cast<size_t>(n) * width);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    double* row = &rows[static_cast<size_t>(i) * width];
+    input->GetPoint(i, row);
+    row += 3;
+    if (useNormals)
+    {
+      normals->GetTuple(i, row);
+      row += 3;
+    }
+    if (useVolumes)
+    {
+      *row++ = mass->GetComponent(i, 0) / density->GetComponent(i, 0);
+    }
+    for (const Cloud::Array& layoutArray : cloud.Arrays)
+    {
+      vtkDataArray* array = pd->GetArray(layoutArray.Name.c_str());
+      for (int c = 0; c < layoutArray.Components; ++c)
+      {
+        *row++ = array->GetComponent(i, c);
+      }
+    }
+  }
+  const vtkMeshFreePieces::GatheredCloud all = vtkMeshFreePieces::GatherCloud(controller, input, rows, width);
+  rows.clear();
+  const vtkIdType count = all.Count;
+  cloud.Count = count;
+  cloud.Points.resize(3 * static_cast<size_t>(count));
+  cloud.Normals.resize(useNormals ? 3 * static_cast<size_t>(count) : 0);
+  cloud.Volumes.resize(useVolumes ? static_cast<size_t>(count) : 0);
+  cloud.Values.resize(static_cast<size_t>(count) * cloud.Columns);
+  cloud.InvalidVolumes = 0;
+  for (vtkIdType i = 0; i < count; ++i)
+  {
+    const double* row = &all.Rows[static_cast<size_t>(i) * width];
+    std::copy_n(row, 3, &cloud.Points[3 * i]);
+    row += 3;
+    if (useNormals)
+    {
+      std::copy_n(row, 3, &cloud.Normals[3 * i]);
+      row += 3;
+    }
+    if (useVolumes)
+    {
+      cloud.Volumes[i] = *row++;
       cloud.InvalidVolumes += (cloud.Volumes[i] > 0.0 && std::isfinite(cloud.Volumes[i])) ? 0 : 1;
     }
+    std::copy_n(row, cloud.Columns, &cloud.Values[static_cast<size_t>(i) * cloud.Columns]);
   }
 }
 
@@ -209,43 +380,18 @@ void vtkMeshlessSurface::ReportReconstruction(const Cloud& cloud, const Result& 
   }
 }
 
-void vtkMeshlessSurface::AddApproximatedArrays(
-  vtkPointSet* input, const Cloud& cloud, vtkPolyData* output, Result& result)
+void vtkMeshlessSurface::AddApproximatedArrays(const Cloud& cloud, vtkPolyData* output, Result& result, bool reporter)
 {
-  // Every other numeric point array, side by side in one row-major table (every component, as double).
-  vtkPointData* inPD = input->GetPointData();
-  std::vector<vtkDataArray*> selected;
-  int columns = 0;
-  for (int a = 0; a < inPD->GetNumberOfArrays(); ++a)
-  {
-    vtkDataArray* array = inPD->GetArray(a);
-    const char* name = array ? array->GetName() : nullptr;
-    if (!name || std::strcmp(name, kNormals) == 0 || std::strcmp(name, kValidMask) == 0)
-    {
-      continue;
-    }
-    selected.push_back(array);
-    columns += array->GetNumberOfComponents();
-  }
+  // Every other numeric point array (Cloud::Arrays, values side by side in Cloud::Values).
+  const int columns = cloud.Columns;
+  const std::vector<double>& values = cloud.Values;
   const vtkIdType n = cloud.Count;
   const vtkIdType m = result.Mesh.NumberOfPoints();
-  if (selected.empty() || columns == 0 || m == 0)
+  if (cloud.Arrays.empty() || columns == 0 || m == 0)
   {
     return;
   }
   const auto start = std::chrono::steady_clock::now();
-  std::vector<double> values(static_cast<size_t>(n) * columns);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    double* row = &values[static_cast<size_t>(i) * columns];
-    for (vtkDataArray* array : selected)
-    {
-      for (int c = 0; c < array->GetNumberOfComponents(); ++c)
-      {
-        *row++ = array->GetComponent(i, c);
-      }
-    }
-  }
 
   meshfree::ApproximationOptions options;
   options.Method = meshfree::ApproximationMethod::MLS;
@@ -259,7 +405,7 @@ void vtkMeshlessSurface::AddApproximatedArrays(
   }
   approximator.SetCloud(cloud.Points.data(), n, values.data(), columns);
   const vtkIdType excludedForValues = approximator.Report().ExcludedPoints - result.Report.InvalidPoints;
-  if (excludedForValues > 0)
+  if (excludedForValues > 0 && reporter)
   {
     vtkWarningMacro(<< excludedForValues
                     << " input points have NaN/Inf in a point array: they are left out of the vertices' values.");
@@ -306,17 +452,17 @@ void vtkMeshlessSurface::AddApproximatedArrays(
 
   vtkPointData* outPD = output->GetPointData();
   int offset = 0;
-  for (vtkDataArray* source : selected)
+  for (const Cloud::Array& source : cloud.Arrays)
   {
-    const int nc = source->GetNumberOfComponents();
+    const int nc = source.Components;
     vtkNew<vtkDoubleArray> array;
-    array->SetName(source->GetName());
+    array->SetName(source.Name.c_str());
     array->SetNumberOfComponents(nc);
     for (int c = 0; c < nc; ++c)
     {
-      if (const char* componentName = source->GetComponentName(c))
+      if (!source.ComponentNames[c].empty())
       {
-        array->SetComponentName(c, componentName);
+        array->SetComponentName(c, source.ComponentNames[c].c_str());
       }
     }
     array->SetNumberOfTuples(m);
@@ -336,9 +482,9 @@ void vtkMeshlessSurface::AddApproximatedArrays(
     mask->SetValue(i, static_cast<char>(valid[i]));
   }
   outPD->AddArray(mask);
-  if (inPD->GetScalars() && inPD->GetScalars()->GetName() && outPD->GetArray(inPD->GetScalars()->GetName()))
+  if (!cloud.ActiveScalars.empty() && outPD->GetArray(cloud.ActiveScalars.c_str()))
   {
-    outPD->SetActiveScalars(inPD->GetScalars()->GetName());
+    outPD->SetActiveScalars(cloud.ActiveScalars.c_str());
   }
   result.ApproximationSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -355,12 +501,22 @@ int vtkMeshlessSurface::RequestData(
   }
   output->Initialize();
 
+  // Under MPI (a piece of several, on several ranks): every rank gathers the whole cloud and reconstructs the whole
+  // surface, then keeps its share of the triangles (see the class doc).
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  const bool distributed = vtkMeshFreePieces::IsDistributed(outInfo);
+  vtkMultiProcessController* controller = distributed ? vtkMultiProcessController::GetGlobalController() : nullptr;
+  const bool reporter = !distributed || controller->GetLocalProcessId() == 0; // one rank warns about the cloud
+
   // Validate and gather.
   Cloud cloud;
-  this->GatherInput(input, cloud);
+  this->GatherInput(input, controller, cloud);
   if (cloud.Count == 0)
   {
-    vtkWarningMacro("The input has no points: no surface.");
+    if (reporter)
+    {
+      vtkWarningMacro("The input has no points: no surface.");
+    }
     return 1;
   }
 
@@ -392,11 +548,45 @@ int vtkMeshlessSurface::RequestData(
     vtkErrorMacro("Invalid settings: " << error << " The output is empty.");
     return 1;
   }
-  this->ReportReconstruction(cloud, result);
+  if (reporter)
+  {
+    this->ReportReconstruction(cloud, result);
+  }
 
-  // Wrap the mesh, then approximate the input's arrays at its vertices.
-  WrapMesh(result.Mesh, output);
-  this->AddApproximatedArrays(input, cloud, output, result);
+  // This rank's share of the triangles (all of them when not distributed), then wrap it and approximate the input's
+  // arrays at its vertices.
+  // (Distributed, the arrays are approximated at every vertex first: the approximation of a vertex may differ in
+  // the last bit with the set of vertices evaluated together, and the share must equal serial bit for bit.)
+  vtkNew<vtkPolyData> whole;
+  WrapMesh(result.Mesh, distributed ? whole.Get() : output);
+  this->AddApproximatedArrays(cloud, distributed ? whole.Get() : output, result, reporter);
+  if (distributed && !result.Aborted)
+  {
+    const vtkMeshFreePieces::Range share = vtkMeshFreePieces::OutputShare(outInfo, result.Mesh.NumberOfTriangles());
+    vtkNew<vtkIdList> kept;
+    WrapMesh(TriangleShare(result.Mesh, share.Begin, share.End, kept), output);
+    vtkPointData* from = whole->GetPointData();
+    vtkPointData* to = output->GetPointData();
+    for (int a = 0; a < from->GetNumberOfArrays(); ++a)
+    {
+      vtkAbstractArray* array = from->GetAbstractArray(a);
+      if (!array->GetName() || std::strcmp(array->GetName(), kNormals) == 0)
+      {
+        continue;
+      }
+      vtkSmartPointer<vtkAbstractArray> part = vtkSmartPointer<vtkAbstractArray>::Take(array->NewInstance());
+      part->SetName(array->GetName());
+      part->SetNumberOfComponents(array->GetNumberOfComponents());
+      part->CopyComponentNames(array);
+      part->SetNumberOfTuples(kept->GetNumberOfIds());
+      array->GetTuples(kept, part);
+      to->AddArray(part);
+    }
+    if (from->GetScalars() && from->GetScalars()->GetName())
+    {
+      to->SetActiveScalars(from->GetScalars()->GetName());
+    }
+  }
   if (result.Aborted)
   {
     output->Initialize();

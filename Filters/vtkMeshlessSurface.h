@@ -34,6 +34,17 @@
  * radius H) and the stages' wall-clock seconds (`SetupSeconds`, `ContourSeconds`, `ProjectionSeconds`,
  * `ApproximationSeconds`).
  *
+ * Under MPI (pvbatch, pvserver: each rank's input is piece = rank of N) the pieces' outputs together are the
+ * serial surface, each triangle on exactly one rank, with the serial vertex positions, Normals and approximated
+ * arrays bit for bit: rank r of N keeps triangles [T r / N, T (r + 1) / N) of the serial run's T, with the
+ * vertices they use (so a vertex shared by two ranks' triangles is on both; the field data is the same on every
+ * rank). The surface is not distributed yet: every rank gathers the whole cloud (coordinates, input Normals, SPH
+ * volumes and the arrays to approximate: an all-gather, ranks with empty pieces included), puts it in global id
+ * order (GlobalIds, else the rank-by-rank concatenation) and runs the serial reconstruction on it, so each rank
+ * spends the serial run's time and memory. A point array is approximated when every rank with points has it
+ * (same name, components); otherwise none is, with a warning. An input that every rank holds whole (piece 0 of 1
+ * on each rank) is reconstructed locally, whole, without communication.
+ *
  * @sa vtkMeshlessNormals vtkMeshlessApproximation vtkSurfaceReconstructionFilter
  */
 #ifndef vtkMeshlessSurface_h
@@ -42,6 +53,7 @@
 #include "MeshFreeFiltersModule.h"
 #include "vtkPolyDataAlgorithm.h"
 
+class vtkMultiProcessController;
 class vtkPointSet;
 
 class MESHFREEFILTERS_EXPORT vtkMeshlessSurface : public vtkPolyDataAlgorithm
@@ -159,9 +171,9 @@ private:
 
   struct Cloud;
   struct Result;
-  void GatherInput(vtkPointSet* input, Cloud& cloud);
+  void GatherInput(vtkPointSet* input, vtkMultiProcessController* controller, Cloud& cloud);
   void ReportReconstruction(const Cloud& cloud, const Result& result);
-  void AddApproximatedArrays(vtkPointSet* input, const Cloud& cloud, vtkPolyData* output, Result& result);
+  void AddApproximatedArrays(const Cloud& cloud, vtkPolyData* output, Result& result, bool reporter);
 };
 
 #endif

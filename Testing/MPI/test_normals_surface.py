@@ -1,0 +1,182 @@
+"""Meshless Normals and Meshless Surface on N ranks against serial, through ParaView's pipeline.
+
+The cloud (a noisy torus of 3,000 points with a few exact duplicates, a `Temperature` array and the point's serial
+index `Id`) comes from a Programmable Source that answers piece requests by index, split evenly (piece p of P:
+[pn/P, (p+1)n/P)) or unevenly with piece 0 empty. Each rank's piece of the filters' outputs is gathered on every
+rank and compared with the serial output of a second proxy updated as piece 0 of 1 in the same process, and (2
+ranks, --reference) with an independent `pvpython --no-mpi` run:
+- Normals: every point on exactly one rank, with its serial Normals, Curvature, SurfaceVariation,
+  OrientationConfidence, vtkValidPointMask (and, with ProjectPoints, coordinates), bit for bit;
+- Surface: the ranks' triangles together are the serial triangles, each exactly once: every triangle as its three
+  vertices' (coordinates, Normals, approximated arrays), rotated to start at its smallest vertex, sorted, compared
+  bit for bit.
+Bitwise, because every rank runs the serial algorithm on the same canonical cloud with the same binary and the
+core gives the same bits whatever its thread count. Also a one-point cloud (no hang, no output).
+--measure: print the differences without failing (how far the pieces are from serial).
+"""
+import builtins
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import numpy as np  # noqa: E402
+from vtkmodules.util import numpy_support as ns  # noqa: E402
+
+import meshfree_mpi as mm  # noqa: E402
+
+MEASURE = "--measure" in sys.argv
+# pvbatch's __main__ holds paraview.simple's names, which shadow some builtins (min) and names like split: the loop
+# variables below avoid them, and soup() calls builtins.min.
+plugin = {"loaded": True}  # a non-empty dict: LoadPlugin ignores an empty one
+mm.load(plugin)
+MeshlessNormals, MeshlessSurface = plugin["MeshlessNormals"], plugin["MeshlessSurface"]
+from paraview import simple  # noqa: E402
+
+CLOUD_SCRIPT = """
+import numpy as np
+from vtkmodules.util import numpy_support as ns
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as sddp
+count, split = {count}, '{split}'
+rng = np.random.default_rng(14)
+u, v = rng.random(count) * 2 * np.pi, rng.random(count) * 2 * np.pi
+R, r = 1.0, 0.4
+xyz = np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], -1)
+xyz += rng.normal(scale=0.004, size=xyz.shape)
+if count > 100:
+    xyz[-10:] = xyz[:10]                          # exact duplicates
+info = self.GetOutputInformation(0)
+piece = info.Get(sddp.UPDATE_PIECE_NUMBER()) if info.Has(sddp.UPDATE_PIECE_NUMBER()) else 0
+pieces = info.Get(sddp.UPDATE_NUMBER_OF_PIECES()) if info.Has(sddp.UPDATE_NUMBER_OF_PIECES()) else 1
+if pieces == 1:
+    lo, hi = 0, count
+elif split == 'even':
+    lo, hi = piece * count // pieces, (piece + 1) * count // pieces
+else:                                             # piece 0 empty, the others growing
+    lo = 0 if piece == 0 else count * (piece - 1) ** 2 // (pieces - 1) ** 2
+    hi = 0 if piece == 0 else count * piece ** 2 // (pieces - 1) ** 2
+out = self.GetPolyDataOutput()
+pts = vtkPoints()
+pts.SetData(ns.numpy_to_vtk(np.ascontiguousarray(xyz[lo:hi]), deep=1))
+out.SetPoints(pts)
+for name, values in (('Id', np.arange(count, dtype=float)), ('Temperature', xyz[:, 2] + 0.5 * xyz[:, 0])):
+    array = ns.numpy_to_vtk(np.ascontiguousarray(values[lo:hi]), deep=1)
+    array.SetName(name)
+    out.GetPointData().AddArray(array)
+"""
+INFO_SCRIPT = """
+from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
+self.GetOutputInformation(0).Set(vtkAlgorithm.CAN_HANDLE_PIECE_REQUEST(), 1)
+"""
+NORMAL_ARRAYS = ["Normals", "Curvature", "SurfaceVariation", "OrientationConfidence", "vtkValidPointMask"]
+SURFACE_ARRAYS = ["Normals", "Temperature", "vtkValidPointMask"]
+
+
+def cloud(count, split):
+    simple.SetActiveSource(None)
+    return simple.ProgrammableSource(OutputDataSetType="vtkPolyData",
+                                     Script=CLOUD_SCRIPT.format(count=count, split=split),
+                                     ScriptRequestInformation=INFO_SCRIPT)
+
+
+def agree(value, what):
+    if MEASURE:
+        values = mm.all_gather(np.array([[float(value)]]))[:, 0]
+        if mm.RANK == 0 and np.ptp(values) > 0:
+            mm.log(f"{what} differs over ranks: {values.tolist()}")
+        return
+    mm.agree(value, what)
+
+
+def compare(label, got, want):
+    """Bitwise (see the module's doc); --measure: report only."""
+    if got.shape != want.shape:
+        mm.log(f"{label}: shape {got.shape} on {mm.RANKS} ranks, serial {want.shape}")
+        mm.check(MEASURE, f"{label}: shapes differ")
+        return
+    diff = np.abs(got - want)
+    if MEASURE:
+        if mm.RANK == 0:
+            rows = int(np.count_nonzero(diff.max(axis=1) > 1e-9)) if got.size else 0
+            mm.log(f"{label}: max |{mm.RANKS} ranks - serial| = {diff.max() if got.size else 0:.3g} "
+                   f"(per column {np.round(diff.max(axis=0), 6).tolist() if got.size else []}), {rows} of "
+                   f"{len(got)} rows differ by more than 1e-9")
+        return
+    mm.compare(label, got, want)
+
+
+def soup(polydata, names):
+    """(triangles, 3 x width) table: each triangle's vertices (xyz, then the named arrays), rotated so that the
+    lexicographically smallest vertex comes first (orientation kept), the triangles sorted."""
+    n = polydata.GetNumberOfPoints() if polydata else 0
+    cols = [np.zeros((0, 3)) if n == 0 else ns.vtk_to_numpy(polydata.GetPoints().GetData()).reshape(n, 3)]
+    for name in names:
+        array = polydata.GetPointData().GetArray(name) if n else None
+        assert array is not None or n == 0, f"array {name} missing"
+        if array is not None:
+            cols.append(ns.vtk_to_numpy(array).reshape(n, array.GetNumberOfComponents()).astype(float))
+    vertex = np.hstack(cols) if n else np.zeros((0, 3 + 3 + len(names) - 1))
+    width = vertex.shape[1]
+    polys = polydata.GetPolys() if polydata else None
+    if not polys or polys.GetNumberOfCells() == 0:
+        return np.zeros((0, 3 * width))
+    offsets = ns.vtk_to_numpy(polys.GetOffsetsArray())
+    assert np.all(np.diff(offsets) == 3), "not only triangles"
+    tri = ns.vtk_to_numpy(polys.GetConnectivityArray()).reshape(-1, 3)
+    out = np.empty((len(tri), 3 * width))
+    for t, (a, b, c) in enumerate(tri):
+        rows = [vertex[a], vertex[b], vertex[c]]
+        first = builtins.min(range(3), key=lambda k: tuple(rows[k]))
+        out[t] = np.concatenate([rows[(first + k) % 3] for k in range(3)])
+    return out[np.lexsort(out.T[::-1])] if len(out) else out
+
+
+def normals_case(label, count, split, **settings):
+    source = cloud(count, split)
+    normals, serial = MeshlessNormals(Input=source, **settings), MeshlessNormals(Input=source, **settings)
+    local = mm.local_output(normals, 0.0)
+    got = mm.gathered_points(local, NORMAL_ARRAYS)
+    want = mm.sorted_rows(mm.rows(mm.serial_output(serial, 0.0), NORMAL_ARRAYS))
+    mm.check(len(want) == count, f"{label}: serial output has {len(want)} of {count} points")
+    compare(f"Normals {label} ({split} split)", got, want)
+    if split == "even":
+        mm.reference(f"normals_{label}", got)
+    for name in ("NoiseEstimate", "SupportRadius", "AmbiguousOrientations"):
+        array = local.GetFieldData().GetArray(name)
+        mm.check(array is not None, f"field {name} missing on rank {mm.RANK}")
+        agree(array.GetTuple1(0), f"Normals {label} ({split} split): field {name}")
+    return normals
+
+
+def surface_case(label, count, split, with_normals=False, **settings):
+    source = cloud(count, split)
+
+    def make():
+        upstream = MeshlessNormals(Input=source) if with_normals else source
+        return MeshlessSurface(Input=upstream, **settings)
+
+    surface, serial = make(), make()
+    local = mm.local_output(surface, 0.0)
+    got = mm.all_gather(soup(local, SURFACE_ARRAYS))
+    got = got[np.lexsort(got.T[::-1])] if len(got) else got
+    want = soup(mm.serial_output(serial, 0.0), SURFACE_ARRAYS)
+    mm.check(len(want) > 1000 or count < 10, f"{label}: serial surface has only {len(want)} triangles")
+    compare(f"Surface {label} ({split} split): {len(want)} serial triangles, {len(got)} on {mm.RANKS} ranks",
+            got, want)
+    if split == "even":
+        mm.reference(f"surface_{label}", got)
+    cell = local.GetFieldData().GetArray("CellSize")
+    agree(cell.GetTuple1(0) if cell else float("nan"), f"Surface {label} ({split} split): field CellSize")
+
+
+for piece_split in ("even", "uneven"):
+    normals_case("auto", 3000, piece_split)
+    normals_case("viewpoint_projected", 3000, piece_split, Orientation="Viewpoint", Viewpoint=[0.0, 0.0, 3.0],
+                 ProjectPoints=1)
+    surface_case("mls", 3000, piece_split)
+    surface_case("wls_input_normals", 3000, piece_split, with_normals=True, Method="WLS")
+
+# One point: no hang, nothing computed, the point on exactly one rank.
+normals_case("one_point", 1, "even")
+surface_case("one_point", 1, "even")
+mm.finish()
