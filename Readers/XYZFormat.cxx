@@ -412,6 +412,7 @@ bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std
         // A piece: the data section starts at this row's line; every piece parsed the lines before it alike.
         table.Values.clear();
         table.Rows = 0;
+        table.IsPiece = true;
         table.DataBegin = static_cast<std::size_t>(lineBegin - data);
         pcd::TextPiece(data, table.DataBegin, size, request->Piece, request->Pieces, table.PieceBegin, table.PieceEnd);
         if (table.DeclaredCount >= 0)
@@ -498,7 +499,7 @@ bool ParsePiece(const char* data, std::size_t size, const pcd::PieceRequest& req
 bool ForEachRowElsewhere(const char* data, std::size_t size, const Table& table, const pcd::MappedFile* mapping,
   const std::function<bool(const double*)>& visit, std::string& error)
 {
-  if (table.PieceEnd == 0)
+  if (!table.IsPiece)
     return true; // the whole file, or a file without rows
   const std::size_t columns = table.Names.size();
   std::vector<double> row(columns);

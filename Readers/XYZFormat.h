@@ -59,8 +59,9 @@ struct Table
   int Coordinate[3] = { 0, 1, 2 }; // the columns holding x, y and z
   std::int64_t DeclaredCount = -1; // Leica's first line, -1 when absent
   /// A piece (ParsePiece): the data section starts at DataBegin (the first row's line) and runs to the end of the
-  /// file; the piece's Rows are the rows of the lines in [PieceBegin, PieceEnd). The whole file: 0, 0, 0.
+  /// file; the piece's Rows are the rows of the lines in [PieceBegin, PieceEnd). The whole file: IsPiece false.
   std::size_t DataBegin = 0, PieceBegin = 0, PieceEnd = 0;
+  bool IsPiece = false;
 };
 
 /// Parses the whole text. On failure returns false, leaves the table empty and says why (with the line).

@@ -114,7 +114,8 @@ int vtkMeshFreeXYZReader::RequestData(
         if (r < firstBad || (r > firstBad && finiteRow(r)))
           rows.push_back(static_cast<vtkIdType>(r));
       vtkWarningMacro("'" << this->FileName << "': dropped " << table.Rows - rows.size() << " of " << table.Rows
-                          << (request.Pieces > 1 ? " points of this piece" : " points") << " whose x, y or z is not a finite number; switch KeepInvalidPoints on to keep them.");
+                          << (request.Pieces > 1 ? " points of this piece" : " points")
+                          << " whose x, y or z is not a finite number; switch KeepInvalidPoints on to keep them.");
     }
   }
   const vtkIdType n = dropped ? static_cast<vtkIdType>(rows.size()) : static_cast<vtkIdType>(table.Rows);
@@ -166,8 +167,9 @@ int vtkMeshFreeXYZReader::RequestData(
     // Whether the columns become RGB depends on every kept row of the file: a piece reads the others' rows too
     // (one at a time, nothing kept), up to the first one that is no colour.
     auto visit = [&](const double* v) {
-      if (!this->KeepInvalidPoints && !(std::isfinite(v[xyz[0]]) && std::isfinite(v[xyz[1]]) && std::isfinite(v[xyz[2]])))
-        return true;
+      const bool finite = std::isfinite(v[xyz[0]]) && std::isfinite(v[xyz[1]]) && std::isfinite(v[xyz[2]]);
+      if (!finite && !this->KeepInvalidPoints)
+        return true; // dropped: no part of the output
       colors = isColor(v);
       return colors;
     };
