@@ -181,8 +181,9 @@ struct AsciiLayout
 
 // Parses the points [first, first + count) from the lines starting at p. On success p is after the last
 // point's line; line counts the newlines passed. False with a message naming the line on any problem.
+// The targets hold point i at index i - targetFirst.
 bool ParseRange(const AsciiLayout& L, const char*& p, const char* end, std::uint64_t first,
-  std::uint64_t count, std::size_t& line, std::string& error)
+  std::uint64_t count, std::size_t& line, std::string& error, std::uint64_t targetFirst = 0)
 {
   const Header& h = *L.Head;
   auto fail = [&](const std::string& what) {
@@ -231,7 +232,7 @@ bool ParseRange(const AsciiLayout& L, const char*& p, const char* end, std::uint
           ++p;
         if (pad)
           continue;
-        unsigned char* out = L.Targets[fi].Base + i * L.Targets[fi].Stride + k * size;
+        unsigned char* out = L.Targets[fi].Base + (i - targetFirst) * L.Targets[fi].Stride + k * size;
         if (!ParseValue(t, p, f, L.Packed[fi], out))
           return fail("'" + std::string(t, std::min<std::size_t>(p - t, 40)) + "' is not a valid value of field '" +
             f.Name + "' (TYPE " + std::string(1, f.Type) + ", SIZE " + std::to_string(f.Size) + ")");
@@ -247,6 +248,24 @@ bool ParseRange(const AsciiLayout& L, const char*& p, const char* end, std::uint
     ++i;
   }
   return true;
+}
+
+AsciiLayout Layout(const Header& h, const std::vector<Target>& targets)
+{
+  AsciiLayout L;
+  L.Head = &h;
+  L.Targets = targets;
+  L.Packed.assign(h.Fields.size(), 0);
+  for (std::size_t i = 0; i < h.Fields.size(); ++i)
+  {
+    L.Packed[i] = IsPackedColor(h.Fields[i]);
+    L.ValuesPad += h.Fields[i].Count;
+    if (h.Fields[i].IsPadding())
+      L.HasPadding = true;
+    else
+      L.ValuesNoPad += h.Fields[i].Count;
+  }
+  return L;
 }
 
 // Lines holding something other than blanks, and newlines, in [b, e). Line ends are found with memchr
@@ -266,7 +285,141 @@ void CountLines(const char* b, const char* e, std::uint64_t& points, std::size_t
     b = nl ? nl + 1 : e;
   }
 }
+// CountLines over [b, e) in windows (cut at line ends), giving back each window's pages afterwards when a
+// mapping holds the data: a pass over the whole file keeps none of it.
+void CountLinesReleasing(const char* data, std::size_t b, std::size_t e, const MappedFile* mapping,
+  std::uint64_t& points, std::size_t& newlines)
+{
+  constexpr std::size_t Window = std::size_t(32) << 20;
+  points = 0, newlines = 0;
+  while (b < e)
+  {
+    std::size_t w = e - b > Window ? b + Window : e;
+    if (w < e)
+    {
+      const char* nl = static_cast<const char*>(std::memchr(data + w, '\n', e - w));
+      w = nl ? static_cast<std::size_t>(nl - data) + 1 : e;
+    }
+    std::uint64_t p = 0;
+    std::size_t n = 0;
+    CountLines(data + b, data + w, p, n);
+    points += p, newlines += n;
+    if (mapping)
+      mapping->Release(b, w);
+    b = w;
+  }
+}
 } // namespace
+
+bool AsciiPieceBounds(const char* data, std::size_t size, const Header& h, const PieceRequest& request,
+  AsciiPiece& piece, std::string& error)
+{
+  TextPiece(data, h.DataStart, size, request.Piece, request.Pieces, piece.Begin, piece.End);
+  std::uint64_t after = 0;
+  std::size_t newlines = 0, skip = 0;
+  CountLinesReleasing(data, h.DataStart, piece.Begin, request.Mapping, piece.First, newlines);
+  CountLines(data + piece.Begin, data + piece.End, piece.Count, skip);
+  CountLinesReleasing(data, piece.End, size, request.Mapping, after, skip);
+  piece.Line = 1 + newlines;
+  for (const char* q = data; q < data + h.DataStart; ++q)
+    piece.Line += (*q == '\n');
+  const std::uint64_t total = piece.First + piece.Count + after;
+  if (total < h.Points)
+  {
+    error = "ascii data: the data ends after " + std::to_string(total) + " of " + std::to_string(h.Points) +
+      " points (truncated, or POINTS does not match)";
+    return false;
+  }
+  if (total > h.Points)
+  {
+    error = "ascii data: " + std::to_string(total) + " lines of points, more data than the " +
+      std::to_string(h.Points) + " points of POINTS";
+    return false;
+  }
+  return true;
+}
+
+bool DecodeAsciiPiece(const char* data, const Header& h, const std::vector<Target>& targets, const AsciiPiece& piece,
+  std::string& error)
+{
+  const AsciiLayout L = Layout(h, targets);
+  const char* p = data + piece.Begin;
+  std::size_t line = piece.Line;
+  return ParseRange(L, p, data + piece.End, piece.First, piece.Count, line, error, piece.First);
+}
+
+bool AsciiInvalidElsewhere(const char* data, std::size_t size, const Header& h, const AsciiPiece& piece,
+  const MappedFile* mapping, bool& found, std::string& error)
+{
+  // The lines outside the piece, parsed in chunks into scratch columns and checked like DropInvalidPoints: this
+  // is a full parse of the rest of the file (kept: one chunk).
+  constexpr std::uint64_t Chunk = 4096;
+  found = false;
+  std::vector<std::vector<unsigned char>> scratch(h.Fields.size());
+  std::vector<Target> targets(h.Fields.size());
+  std::vector<int> coordinates;
+  for (std::size_t i = 0; i < h.Fields.size(); ++i)
+  {
+    const Field& f = h.Fields[i];
+    if (f.IsPadding())
+      continue;
+    scratch[i].resize(Chunk * f.Bytes());
+    targets[i] = { scratch[i].data(), f.Bytes() };
+    if ((f.Name == "x" || f.Name == "y" || f.Name == "z") && f.Type == 'F' && f.Count == 1)
+      coordinates.push_back(static_cast<int>(i));
+  }
+  if (coordinates.empty())
+    return true;
+  const AsciiLayout L = Layout(h, targets);
+  struct Range
+  {
+    std::size_t Begin, End;
+    std::uint64_t First, Count;
+    std::size_t Line;
+  };
+  std::size_t firstLine = 1;
+  for (const char* q = data; q < data + h.DataStart; ++q)
+    firstLine += (*q == '\n');
+  const Range ranges[] = { { h.DataStart, piece.Begin, 0, piece.First, firstLine },
+    { piece.End, size, piece.First + piece.Count, h.Points - piece.First - piece.Count, 0 } };
+  for (const Range& r : ranges)
+  {
+    const char* p = data + r.Begin;
+    std::size_t line = r.Line;
+    if (&r != &ranges[0])
+    {
+      line = piece.Line;
+      for (const char* q = data + piece.Begin; q < p; ++q)
+        line += (*q == '\n');
+    }
+    for (std::uint64_t i = r.First; i < r.First + r.Count && !found;)
+    {
+      const std::uint64_t n = std::min(Chunk, r.First + r.Count - i);
+      const char* before = p;
+      if (!ParseRange(L, p, data + r.End, i, n, line, error, i))
+        return false;
+      for (std::uint64_t k = 0; k < n && !found; ++k)
+        for (int c : coordinates)
+        {
+          const Field& f = h.Fields[c];
+          double v;
+          if (f.Size == 4)
+          {
+            float x;
+            std::memcpy(&x, scratch[c].data() + 4 * k, 4);
+            v = x;
+          }
+          else
+            std::memcpy(&v, scratch[c].data() + 8 * k, 8);
+          found = found || !std::isfinite(v);
+        }
+      if (mapping)
+        mapping->Release(static_cast<std::size_t>(before - data), static_cast<std::size_t>(p - data));
+      i += n;
+    }
+  }
+  return true;
+}
 
 bool DecodeAscii(const char* data, std::size_t size, const Header& h, const std::vector<Target>& targets,
   std::string& error)
@@ -277,19 +430,7 @@ bool DecodeAscii(const char* data, std::size_t size, const Header& h, const std:
   for (const char* q = data; q < p; ++q)
     line += (*q == '\n');
 
-  AsciiLayout L;
-  L.Head = &h;
-  L.Targets = targets;
-  L.Packed.assign(h.Fields.size(), 0);
-  for (std::size_t i = 0; i < h.Fields.size(); ++i)
-  {
-    L.Packed[i] = IsPackedColor(h.Fields[i]);
-    L.ValuesPad += h.Fields[i].Count;
-    if (h.Fields[i].IsPadding())
-      L.HasPadding = true;
-    else
-      L.ValuesNoPad += h.Fields[i].Count;
-  }
+  const AsciiLayout L = Layout(h, targets);
 
   // Large files: split the data at line boundaries and parse the pieces on all cores. Each piece's
   // first point and line number come from a (parallel) count of its lines. If the counts do not add up

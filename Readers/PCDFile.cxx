@@ -2,6 +2,7 @@
 #include "PCDFormat.h"
 #include "PCDInternal.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -128,7 +129,7 @@ MappedFile::~MappedFile()
     munmap(const_cast<char*>(this->Ptr), this->Length);
 }
 
-bool MappedFile::Open(const std::string& path, std::string& error)
+bool MappedFile::Open(const std::string& path, std::string& error, bool populate)
 {
   const int fd = ::open(path.c_str(), O_RDONLY);
   if (fd < 0)
@@ -146,7 +147,7 @@ bool MappedFile::Open(const std::string& path, std::string& error)
   this->Length = static_cast<std::size_t>(st.st_size);
   if (this->Length > 0)
   {
-    void* p = mmap(nullptr, this->Length, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    void* p = mmap(nullptr, this->Length, PROT_READ, MAP_PRIVATE | (populate ? MAP_POPULATE : 0), fd, 0);
     if (p == MAP_FAILED)
     {
       ::close(fd);
@@ -157,11 +158,23 @@ bool MappedFile::Open(const std::string& path, std::string& error)
     this->Ptr = static_cast<const char*>(p);
     this->Mapped = true;
 #ifdef MADV_POPULATE_READ
-    madvise(p, this->Length, MADV_POPULATE_READ); // page tables in one call, not one fault per page
+    if (populate)
+      madvise(p, this->Length, MADV_POPULATE_READ); // page tables in one call, not one fault per page
 #endif
   }
   ::close(fd);
   return true;
+}
+
+void MappedFile::Release(std::size_t begin, std::size_t end) const
+{
+  const std::size_t page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  const auto base = reinterpret_cast<std::uintptr_t>(this->Ptr);
+  end = std::min(end, this->Length);
+  // The mapping starts at a page; only whole pages inside the range go.
+  const std::size_t b = (begin + page - 1) / page * page, e = end / page * page;
+  if (this->Mapped && e > b)
+    madvise(reinterpret_cast<void*>(base + b), e - b, MADV_DONTNEED);
 }
 
 std::uint64_t DropInvalidPoints(Cloud& cloud, std::vector<std::uint64_t>* keptIndex)

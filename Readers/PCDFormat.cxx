@@ -302,7 +302,36 @@ bool ParseHeader(const char* data, std::size_t size, Header& header, std::string
   return false;
 }
 
-bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error, bool interleaveXYZ)
+namespace
+{
+// floor(n * k / pieces) without overflow.
+std::uint64_t Share(std::uint64_t n, int k, int pieces)
+{
+  return static_cast<std::uint64_t>(static_cast<unsigned __int128>(n) * static_cast<unsigned>(k) /
+    static_cast<unsigned>(pieces));
+}
+
+bool IsCoordinate(const Field& f)
+{
+  return (f.Name == "x" || f.Name == "y" || f.Name == "z") && f.Type == 'F' && f.Count == 1;
+}
+
+bool IsFinite(const unsigned char* p, int size)
+{
+  if (size == 4)
+  {
+    float v;
+    std::memcpy(&v, p, 4);
+    return std::isfinite(v);
+  }
+  double v;
+  std::memcpy(&v, p, 8);
+  return std::isfinite(v);
+}
+
+// request null: the whole file (Decode); otherwise a piece (DecodePiece).
+bool DecodeImpl(const char* data, std::size_t size, Cloud& cloud, std::string& error, bool interleaveXYZ,
+  const PieceRequest* request)
 {
   cloud = Cloud();
   Header header;
@@ -385,6 +414,30 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
     }
   }
 
+  // The share of a piece: the points [first, first + count).
+  std::uint64_t first = 0, count = n;
+  const bool piece = request && request->Pieces > 1;
+  detail::AsciiPiece lines;
+  if (piece)
+  {
+    if (request->Piece < 0 || request->Piece >= request->Pieces)
+    {
+      error = "piece " + std::to_string(request->Piece) + " of " + std::to_string(request->Pieces) + " does not exist";
+      return false;
+    }
+    if (header.Data == Encoding::Ascii)
+    {
+      if (!detail::AsciiPieceBounds(data, size, header, *request, lines, error))
+        return false;
+      first = lines.First, count = lines.Count;
+    }
+    else
+    {
+      first = Share(n, request->Piece, request->Pieces);
+      count = Share(n, request->Piece + 1, request->Pieces) - first;
+    }
+  }
+
   cloud.Head = header;
   // Where each field goes: x, y, z and normal_x, normal_y, normal_z (each triple one floating type, COUNT 1)
   // into the interleaved points and normals when asked, every other non-padding field into its own column.
@@ -416,7 +469,7 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
       continue;
     const std::size_t s = static_cast<std::size_t>(header.Fields[field[0]].Size);
     Buffer& storage = cloud.*t.Storage;
-    if (!storage.Allocate(n * 3 * s))
+    if (!storage.Allocate(count * 3 * s))
       return outOfMemory();
     cloud.*t.Size = static_cast<int>(s);
     for (int k = 0; k < 3; ++k)
@@ -428,14 +481,21 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
       continue;
     cloud.ColumnField.push_back(static_cast<int>(i));
     cloud.Columns.emplace_back();
-    if (!cloud.Columns.back().Allocate(n * header.Fields[i].Bytes()))
+    if (!cloud.Columns.back().Allocate(count * header.Fields[i].Bytes()))
       return outOfMemory();
     targets[i] = { cloud.Columns.back().Data(), header.Fields[i].Bytes() };
   }
 
   bool ok = true;
+  bool invalidElsewhere = false;
+  const bool findInvalid = piece && request->FindInvalid && header.Height > 1;
   if (header.Data == Encoding::Ascii)
-    ok = detail::DecodeAscii(data, size, header, targets, error);
+  {
+    ok = piece ? detail::DecodeAsciiPiece(data, header, targets, lines, error)
+               : detail::DecodeAscii(data, size, header, targets, error);
+    if (ok && findInvalid)
+      ok = detail::AsciiInvalidElsewhere(data, size, header, lines, request->Mapping, invalidElsewhere, error);
+  }
   else if (header.Data == Encoding::Binary)
   {
     std::size_t offset = 0;
@@ -443,8 +503,30 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
     {
       const Field& f = header.Fields[i];
       if (targets[i].Base)
-        StridedCopy(body + offset, recordBytes, n, f.Bytes(), targets[i].Base, targets[i].Stride);
+        StridedCopy(body + first * recordBytes + offset, recordBytes, count, f.Bytes(), targets[i].Base,
+          targets[i].Stride);
       offset += f.Bytes();
+    }
+    if (findInvalid)
+    {
+      // The coordinates of the records outside the share, in windows whose pages are given back afterwards.
+      constexpr std::uint64_t Window = 1 << 16;
+      const std::uint64_t ranges[2][2] = { { 0, first }, { first + count, n } };
+      for (const auto& r : ranges)
+        for (std::uint64_t b = r[0]; b < r[1] && !invalidElsewhere; b += Window)
+        {
+          const std::uint64_t e = std::min(r[1], b + Window);
+          std::size_t fieldOffset = 0;
+          for (const Field& f : header.Fields)
+          {
+            if (IsCoordinate(f))
+              for (std::uint64_t i = b; i < e; ++i)
+                invalidElsewhere = invalidElsewhere || !IsFinite(body + i * recordBytes + fieldOffset, f.Size);
+            fieldOffset += f.Bytes();
+          }
+          if (request->Mapping)
+            request->Mapping->Release(header.DataStart + b * recordBytes, header.DataStart + e * recordBytes);
+        }
     }
   }
   else if (n > 0)
@@ -467,23 +549,83 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
       }
       else
       {
-        // Structure of arrays: one block of n values per field.
+        // Structure of arrays: one block of n values per field; a piece copies its share of each block.
         std::size_t offset = 0;
         for (std::size_t i = 0; i < header.Fields.size(); ++i)
         {
           const Field& f = header.Fields[i];
           if (f.IsPadding() && !withPadding)
             continue;
+          const unsigned char* block = expanded.Data() + offset;
           if (targets[i].Base)
-            StridedCopy(expanded.Data() + offset, f.Bytes(), n, f.Bytes(), targets[i].Base, targets[i].Stride);
+            StridedCopy(block + first * f.Bytes(), f.Bytes(), count, f.Bytes(), targets[i].Base, targets[i].Stride);
+          if (findInvalid && IsCoordinate(f))
+          {
+            for (std::uint64_t k = 0; k < first && !invalidElsewhere; ++k)
+              invalidElsewhere = !IsFinite(block + k * f.Size, f.Size);
+            for (std::uint64_t k = first + count; k < n && !invalidElsewhere; ++k)
+              invalidElsewhere = !IsFinite(block + k * f.Size, f.Size);
+          }
           offset += n * f.Bytes();
         }
       }
     }
   }
   if (!ok)
+  {
     cloud = Cloud();
-  return ok;
+    return false;
+  }
+  cloud.Head.Points = count;
+  cloud.First = first;
+  cloud.FilePoints = n;
+  cloud.InvalidElsewhere = invalidElsewhere;
+  return true;
+}
+} // namespace
+
+bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error, bool interleaveXYZ)
+{
+  return DecodeImpl(data, size, cloud, error, interleaveXYZ, nullptr);
+}
+
+bool DecodePiece(const char* data, std::size_t size, const PieceRequest& request, Cloud& cloud, std::string& error,
+  bool interleaveXYZ)
+{
+  return DecodeImpl(data, size, cloud, error, interleaveXYZ, &request);
+}
+
+bool ReadPiece(const std::string& path, PieceRequest request, Cloud& cloud, std::string& error, bool interleaveXYZ)
+{
+  cloud = Cloud();
+  MappedFile file;
+  // One piece of several: mapped only, so that the rank reads the pages of its share alone.
+  if (!file.Open(path, error, /*populate=*/request.Pieces <= 1))
+    return false;
+  request.Mapping = &file;
+  return DecodePiece(file.Data(), file.Size(), request, cloud, error, interleaveXYZ);
+}
+
+void TextPiece(const char* data, std::size_t begin, std::size_t end, int piece, int pieces, std::size_t& pieceBegin,
+  std::size_t& pieceEnd)
+{
+  // The first line start at or after byte `at` of the section.
+  auto lineStart = [&](std::size_t at) {
+    if (at <= begin)
+      return begin;
+    if (at >= end)
+      return end;
+    if (data[at - 1] == '\n')
+      return at;
+    const char* nl = static_cast<const char*>(std::memchr(data + at, '\n', end - at));
+    return nl ? static_cast<std::size_t>(nl - data) + 1 : end;
+  };
+  if (pieces < 1)
+    pieces = 1;
+  const std::uint64_t bytes = end > begin ? end - begin : 0;
+  pieceBegin = piece <= 0 ? begin : lineStart(begin + static_cast<std::size_t>(Share(bytes, piece, pieces)));
+  pieceEnd = piece + 1 >= pieces ? std::max(end, begin)
+                                 : lineStart(begin + static_cast<std::size_t>(Share(bytes, piece + 1, pieces)));
 }
 
 bool ReadFile(const std::string& path, Cloud& cloud, std::string& error, bool interleaveXYZ)

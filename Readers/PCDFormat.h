@@ -95,13 +95,16 @@ private:
 /// normal_y, normal_z go into Normals as triples (NormalsSize 4 or 8).
 struct Cloud
 {
-  Header Head;
+  Header Head; // Points: the points decoded (a piece's share, see DecodePiece); Width, Height: the file's
   std::vector<int> ColumnField; // index into Head.Fields of each column
   std::vector<Buffer> Columns;
   Buffer Points;
   int PointsSize = 0; // 0: no interleaved points
   Buffer Normals;
   int NormalsSize = 0; // 0: no interleaved normals
+  std::uint64_t First = 0;       // index in the file of the first decoded point (0 unless a piece)
+  std::uint64_t FilePoints = 0;  // POINTS of the file
+  bool InvalidElsewhere = false; // a piece with PieceRequest::FindInvalid: a point outside it has a NaN x, y or z
 };
 
 /// Parses the header at the start of data. On failure returns false and a message naming the problem.
@@ -112,6 +115,45 @@ bool Decode(const char* data, std::size_t size, Cloud& cloud, std::string& error
 
 /// Reads and decodes a file (one bulk read).
 bool ReadFile(const std::string& path, Cloud& cloud, std::string& error, bool interleaveXYZ = false);
+
+class MappedFile;
+
+/// Piece Piece of Pieces of a file, as the VTK pipeline asks for it under MPI.
+struct PieceRequest
+{
+  int Piece = 0;
+  int Pieces = 1;
+  /// For an organised cloud (HEIGHT > 1), also find out whether a point outside the piece has a NaN (or infinite)
+  /// x, y or z (Cloud::InvalidElsewhere): what its PixelIndex depends on. Costs a pass over the rest of the file
+  /// (ascii: parsing its lines, so that their errors are found by every piece too).
+  bool FindInvalid = false;
+  /// The mapping that holds the data, if any: the pages outside the piece that a pass over the whole file
+  /// touched are given back (the rank keeps only its share's pages).
+  const MappedFile* Mapping = nullptr;
+};
+
+/// Decodes the share of the points that piece p of N gets, in file order (concatenating the pieces in order gives
+/// exactly Decode's cloud): cloud.First is its first point's index in the file, cloud.Head.Points its count.
+/// - binary: points [floor(p n / N), floor((p+1) n / N)); only their records are touched.
+/// - binary_compressed: the same share, but the LZF blob (all fields, column-major) cannot be split: it is
+///   decompressed whole, the share copied out and the rest freed.
+/// - ascii: the data section is cut into N byte ranges of equal size; a line belongs to the piece whose range holds
+///   its first byte. The shares are contiguous but not of floor(p n / N) points. Every piece counts the lines of the
+///   whole section (memchr; nothing kept) so that a POINTS that does not match fails on every piece; a value that
+///   does not parse fails on the piece that holds its line only.
+/// Errors in the header, the sizes or the counts are found by every piece alike. Pieces = 1 is Decode.
+bool DecodePiece(const char* data, std::size_t size, const PieceRequest& request, Cloud& cloud, std::string& error,
+  bool interleaveXYZ = false);
+
+/// Maps a file (lazily: only the pages a piece touches are read) and decodes a piece of it (DecodePiece).
+bool ReadPiece(const std::string& path, PieceRequest request, Cloud& cloud, std::string& error,
+  bool interleaveXYZ = false);
+
+/// Piece `piece` of `pieces` of the lines of a text section [begin, end) of data: the section cut into byte ranges of
+/// equal size, each line going to the range that holds its first byte. [pieceBegin, pieceEnd) start at line starts;
+/// the pieces in order tile the section.
+void TextPiece(const char* data, std::size_t begin, std::size_t end, int piece, int pieces, std::size_t& pieceBegin,
+  std::size_t& pieceEnd);
 
 /// Removes the points whose x, y or z is NaN or infinite (PCL's marker of invalid points), from every
 /// column (and from Points and Normals). keptIndex (optional) receives the original index of each kept point, or
@@ -127,7 +169,8 @@ bool Encode(const Header& header, const std::vector<const void*>& columns, std::
 bool WriteFile(const std::string& path, const Header& header,
   const std::vector<const void*>& columns, std::string& error);
 
-/// A read-only memory map of a whole file (pre-faulted: the kernel maps the page cache in one call, no copy).
+/// A read-only memory map of a whole file (pre-faulted unless asked not to: the kernel maps the page cache in one
+/// call, no copy).
 class MappedFile
 {
 public:
@@ -135,9 +178,12 @@ public:
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
   ~MappedFile();
-  bool Open(const std::string& path, std::string& error);
+  /// populate false: map only, the pages are read when touched (a piece of the file).
+  bool Open(const std::string& path, std::string& error, bool populate = true);
   const char* Data() const { return this->Ptr; }
   std::size_t Size() const { return this->Length; }
+  /// Gives back the pages wholly inside [begin, end) (read again from the file if touched later).
+  void Release(std::size_t begin, std::size_t end) const;
 
 private:
   const char* Ptr = "";

@@ -27,6 +27,26 @@ struct Target
 bool DecodeAscii(const char* data, std::size_t size, const Header& header, const std::vector<Target>& targets,
   std::string& error);
 
+/// Where the lines of an ascii piece are (TextPiece) and which points they hold.
+struct AsciiPiece
+{
+  std::size_t Begin = 0, End = 0; // bytes of the file
+  std::uint64_t First = 0, Count = 0;
+  std::size_t Line = 1; // the number of the line at Begin
+};
+
+/// The piece's lines and points; counts the point lines of the whole data section, which must be POINTS.
+bool AsciiPieceBounds(const char* data, std::size_t size, const Header& header, const PieceRequest& request,
+  AsciiPiece& piece, std::string& error);
+
+/// Decodes the piece's lines into targets (one per field) allocated for piece.Count points.
+bool DecodeAsciiPiece(const char* data, const Header& header, const std::vector<Target>& targets,
+  const AsciiPiece& piece, std::string& error);
+
+/// found: whether a line outside the piece has a NaN or infinite x, y or z (parses those lines).
+bool AsciiInvalidElsewhere(const char* data, std::size_t size, const Header& header, const AsciiPiece& piece,
+  const MappedFile* mapping, bool& found, std::string& error);
+
 /// Appends the ascii data section of an encoded cloud.
 void EncodeAscii(const Header& header, const std::vector<const void*>& columns, std::string& out);
 

@@ -238,6 +238,63 @@ bool ParseData(const char* b, const char* e, std::size_t columns, std::size_t li
   return true;
 }
 
+// CountRows over [b, e) of data in windows (cut at line ends), giving back the pages of each window afterwards.
+std::uint64_t CountRowsReleasing(const char* data, std::size_t b, std::size_t e, const pcd::MappedFile* mapping)
+{
+  constexpr std::size_t Window = std::size_t(32) << 20;
+  std::uint64_t total = 0;
+  while (b < e)
+  {
+    std::size_t w = e - b > Window ? b + Window : e;
+    if (w < e)
+    {
+      const char* nl = static_cast<const char*>(std::memchr(data + w, '\n', e - w));
+      w = nl ? static_cast<std::size_t>(nl - data) + 1 : e;
+    }
+    std::uint64_t rows = 0;
+    std::size_t newlines = 0;
+    CountRows(data + b, data + w, rows, newlines);
+    total += rows;
+    if (mapping)
+      mapping->Release(b, w);
+    b = w;
+  }
+  return total;
+}
+
+// The line number of the line before data + at.
+std::size_t LinesBefore(const char* data, std::size_t at)
+{
+  return static_cast<std::size_t>(std::count(data, data + at, '\n'));
+}
+
+// The rows of [table.PieceBegin, table.PieceEnd) of a piece: counted, allocated once, parsed in place.
+bool ParsePieceRows(const char* data, std::size_t columns, Table& table, std::string& error)
+{
+  const char* b = data + table.PieceBegin;
+  const char* e = data + table.PieceEnd;
+  std::uint64_t rows = 0;
+  std::size_t newlines = 0;
+  CountRows(b, e, rows, newlines);
+  try
+  {
+    table.Values.resize(rows * columns);
+  }
+  catch (const std::bad_alloc&)
+  {
+    error = "out of memory for " + std::to_string(rows) + " rows of " + std::to_string(columns) + " columns";
+    return false;
+  }
+  // Line numbers cost a pass over the file before the piece: counted only for a message.
+  if (!ParseRows(b, e, columns, table.Values.data(), true, 0, error))
+  {
+    ParseRows(b, e, columns, table.Values.data(), false, LinesBefore(data, table.PieceBegin), error);
+    return false;
+  }
+  table.Rows = rows;
+  return true;
+}
+
 std::string Lower(std::string s)
 {
   for (char& c : s)
@@ -245,8 +302,11 @@ std::string Lower(std::string s)
   return s;
 }
 
-bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std::string& error)
+// request: a piece (ParsePiece), null: the whole data.
+bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std::string& error,
+  const pcd::PieceRequest* request = nullptr)
 {
+  std::uint64_t fileRows = 0; // a piece: the rows of the whole file, counted only for a Leica count
   table = Table();
   const char* p = data;
   const char* end = data + size;
@@ -263,6 +323,7 @@ bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std
   while (p < end)
   {
     const char* nl = static_cast<const char*>(std::memchr(p, '\n', end - p));
+    const char* lineBegin = p;
     const char* b = p;
     const char* e = nl ? nl : end;
     p = nl ? nl + 1 : end;
@@ -346,6 +407,25 @@ bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std
         table.Values.push_back(v);
       }
       ++table.Rows;
+      if (!sniff && request && request->Pieces > 1)
+      {
+        // A piece: the data section starts at this row's line; every piece parsed the lines before it alike.
+        table.Values.clear();
+        table.Rows = 0;
+        table.IsPiece = true;
+        table.DataBegin = static_cast<std::size_t>(lineBegin - data);
+        pcd::TextPiece(data, table.DataBegin, size, request->Piece, request->Pieces, table.PieceBegin, table.PieceEnd);
+        if (table.DeclaredCount >= 0)
+          fileRows = CountRowsReleasing(data, table.DataBegin, table.PieceBegin, request->Mapping) +
+            CountRowsReleasing(data, table.PieceEnd, size, request->Mapping);
+        if (!ParsePieceRows(data, columns, table, error))
+        {
+          table = Table();
+          return false;
+        }
+        fileRows += table.Rows;
+        break;
+      }
       if (!sniff)
       {
         // The rest is data: in bulk.
@@ -387,10 +467,12 @@ bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std
     for (std::size_t c = 0; c < columns; ++c)
       table.Names.push_back(c < 3 ? std::string(1, "xyz"[c]) : "Column" + std::to_string(c + 1));
   }
-  if (!sniff && table.DeclaredCount >= 0 && static_cast<std::uint64_t>(table.DeclaredCount) != table.Rows)
+  if (!(request && request->Pieces > 1 && inData))
+    fileRows = table.Rows;
+  if (!sniff && table.DeclaredCount >= 0 && static_cast<std::uint64_t>(table.DeclaredCount) != fileRows)
   {
     error = "the first line announces " + std::to_string(table.DeclaredCount) + " points, the file holds " +
-      std::to_string(table.Rows);
+      std::to_string(fileRows);
     table = Table();
     return false;
   }
@@ -401,6 +483,53 @@ bool ParseImpl(const char* data, std::size_t size, bool sniff, Table& table, std
 bool Parse(const char* data, std::size_t size, Table& table, std::string& error)
 {
   return ParseImpl(data, size, false, table, error);
+}
+
+bool ParsePiece(const char* data, std::size_t size, const pcd::PieceRequest& request, Table& table, std::string& error)
+{
+  if (request.Pieces > 1 && (request.Piece < 0 || request.Piece >= request.Pieces))
+  {
+    table = Table();
+    error = "piece " + std::to_string(request.Piece) + " of " + std::to_string(request.Pieces) + " does not exist";
+    return false;
+  }
+  return ParseImpl(data, size, false, table, error, &request);
+}
+
+bool ForEachRowElsewhere(const char* data, std::size_t size, const Table& table, const pcd::MappedFile* mapping,
+  const std::function<bool(const double*)>& visit, std::string& error)
+{
+  if (!table.IsPiece)
+    return true; // the whole file, or a file without rows
+  const std::size_t columns = table.Names.size();
+  std::vector<double> row(columns);
+  const std::size_t ranges[2][2] = { { table.DataBegin, table.PieceBegin }, { table.PieceEnd, size } };
+  for (const auto& r : ranges)
+  {
+    std::size_t at = r[0], released = r[0];
+    while (at < r[1])
+    {
+      const char* b = data + at;
+      const char* nl = static_cast<const char*>(std::memchr(b, '\n', r[1] - at));
+      const char* le = nl ? nl : data + r[1];
+      if (IsRowLine(b, le))
+      {
+        if (!FastRow(b, le, columns, row.data()))
+        {
+          error = "line " + std::to_string(LinesBefore(data, at) + 1) + ": " + RowError(b, le, columns);
+          return false;
+        }
+        if (!visit(row.data()))
+          return true;
+      }
+      at = nl ? static_cast<std::size_t>(nl - data) + 1 : r[1];
+      if (mapping && at - released > (std::size_t(32) << 20))
+        mapping->Release(released, at), released = at;
+    }
+    if (mapping)
+      mapping->Release(released, r[1]);
+  }
+  return true;
 }
 
 bool LooksBinary(const char* data, std::size_t size)

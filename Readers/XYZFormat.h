@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <new>
 #include <string>
 #include <utility>
@@ -57,12 +58,30 @@ struct Table
   std::vector<double, BulkAllocator<double>> Values; // Rows x Names.size(), row-major
   int Coordinate[3] = { 0, 1, 2 }; // the columns holding x, y and z
   std::int64_t DeclaredCount = -1; // Leica's first line, -1 when absent
+  /// A piece (ParsePiece): the data section starts at DataBegin (the first row's line) and runs to the end of the
+  /// file; the piece's Rows are the rows of the lines in [PieceBegin, PieceEnd). The whole file: IsPiece false.
+  std::size_t DataBegin = 0, PieceBegin = 0, PieceEnd = 0;
+  bool IsPiece = false;
 };
 
 /// Parses the whole text. On failure returns false, leaves the table empty and says why (with the line).
 /// The header lines are read one by one; the data rows are counted, allocated once and parsed in place,
 /// in pieces on several threads for large files.
 bool Parse(const char* data, std::size_t size, Table& table, std::string& error);
+
+/// Parses the lines before the data (header, count, comments) and then only the rows of piece
+/// request.Piece of request.Pieces: the data section cut into byte ranges of equal size (pcd::TextPiece), each
+/// line going to the piece whose range holds its first byte. Concatenating the pieces' rows in order gives Parse's
+/// rows; the shares are contiguous but not of equal row counts. A Leica count line makes every piece count the
+/// rows of the whole section (memchr, nothing kept), so that a count that does not match fails on every piece; a
+/// row that does not parse fails on the piece that holds it only. Pieces = 1 is Parse.
+bool ParsePiece(const char* data, std::size_t size, const pcd::PieceRequest& request, Table& table, std::string& error);
+
+/// Calls visit(row) with each row (all columns) of the data section outside the piece that table holds, in file order,
+/// until visit returns false. For what depends on every row (the reader's colour columns). False, with the line
+/// and what is wrong, on a row that does not parse. mapping: the pages it read are given back.
+bool ForEachRowElsewhere(const char* data, std::size_t size, const Table& table, const pcd::MappedFile* mapping,
+  const std::function<bool(const double*)>& visit, std::string& error);
 
 /// True when the start of data reads as a text point cloud (consistent rows of >= 3 numbers). Used to
 /// tell point clouds from the other formats that use ".xyz" (PLOT3D grids, XMol molecules).

@@ -101,22 +101,30 @@ int vtkMeshFreePCDReader::RequestData(
   namespace pcd = meshfree::pcd;
   pcd::Cloud cloud;
   std::string error;
-  if (!pcd::ReadFile(this->FileName, cloud, error, /*interleaveXYZ=*/true))
+  pcd::PieceRequest request;
+  this->GetPiece(outputVector, request.Piece, request.Pieces);
+  // An organised cloud's PixelIndex is there when any point of the file was dropped: a piece must know about the
+  // others' points too.
+  request.FindInvalid = !this->KeepInvalidPoints;
+  const bool ok = request.Pieces > 1 ? pcd::ReadPiece(this->FileName, request, cloud, error, /*interleaveXYZ=*/true)
+                                     : pcd::ReadFile(this->FileName, cloud, error, /*interleaveXYZ=*/true);
+  if (!ok)
   {
     vtkErrorMacro("Cannot read '" << this->FileName << "': " << error);
     return 1;
   }
   this->UpdateProgress(0.5);
   const pcd::Header& head = cloud.Head;
-  const std::uint64_t fileWidth = head.Width, fileHeight = head.Height, filePoints = head.Points;
+  const std::uint64_t fileWidth = head.Width, fileHeight = head.Height, piecePoints = head.Points;
   std::vector<std::uint64_t> kept;
   if (!this->KeepInvalidPoints)
   {
     const std::uint64_t dropped = pcd::DropInvalidPoints(cloud, &kept);
     if (dropped > 0)
     {
-      vtkWarningMacro("'" << this->FileName << "': dropped " << dropped << " of " << filePoints
-                          << " points whose x, y or z is NaN (invalid points); switch KeepInvalidPoints on to keep them.");
+      vtkWarningMacro("'" << this->FileName << "': dropped " << dropped << " of " << piecePoints
+                          << (request.Pieces > 1 ? " points of this piece" : " points")
+                          << " whose x, y or z is NaN (invalid points); switch KeepInvalidPoints on to keep them.");
     }
   }
   const vtkIdType n = static_cast<vtkIdType>(cloud.Head.Points);
@@ -216,13 +224,14 @@ int vtkMeshFreePCDReader::RequestData(
     array->SetName(name.c_str());
     output->GetPointData()->AddArray(array);
   }
-  if (!kept.empty() && fileHeight > 1)
+  if ((!kept.empty() || cloud.InvalidElsewhere) && fileHeight > 1)
   {
+    // Indices in the file's WIDTH x HEIGHT grid (a piece's kept[i] counts from its first point).
     vtkNew<vtkIdTypeArray> pixel;
     pixel->SetName("PixelIndex");
     pixel->SetNumberOfValues(n);
     for (vtkIdType i = 0; i < n; ++i)
-      pixel->SetValue(i, static_cast<vtkIdType>(kept[i]));
+      pixel->SetValue(i, static_cast<vtkIdType>(cloud.First + (kept.empty() ? i : kept[i])));
     output->GetPointData()->AddArray(pixel);
   }
 

@@ -21,6 +21,18 @@
  * A file that does not parse (truncated data, counts that do not match, unknown types, compressed sizes
  * that lie, ...) gives an error naming the problem and an empty output.
  *
+ * Pieces (MPI, see vtkMeshFreePointCloudReader): piece p of N is a contiguous share of the points in file order,
+ * the pieces concatenated being the whole output bit for bit; every piece has the same arrays and field data.
+ * - binary: the points [floor(p n / N), floor((p+1) n / N)); only their records are read.
+ * - binary_compressed: the same share, but the LZF blob (all fields, column-major) cannot be split: each piece
+ *   decompresses the whole of it, copies its share out and frees the rest.
+ * - ascii: the data section is cut into N byte ranges of equal size, a line belonging to the piece whose range
+ *   holds its first byte (not floor(n/N) points each). Each piece counts the lines of the whole section, so that a
+ *   POINTS that does not match fails on every piece; a value that does not parse fails on its piece only.
+ * - an organised cloud (HEIGHT > 1) whose invalid points are dropped: whether PixelIndex is there depends on the
+ *   whole file, so each piece also reads the others' points (ascii: parses their lines), keeping none of them;
+ *   PixelIndex is the index in the file's grid, and the dropped-points warning counts the piece's points.
+ *
  * @sa vtkMeshFreePCDWriter vtkMeshFreeXYZReader
  */
 #ifndef vtkMeshFreePCDReader_h

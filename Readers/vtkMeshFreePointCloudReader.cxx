@@ -1,6 +1,10 @@
 #include "vtkMeshFreePointCloudReader.h"
 
+#include "vtkAlgorithm.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
 #include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 
 vtkMeshFreePointCloudReader::vtkMeshFreePointCloudReader()
 {
@@ -10,6 +14,25 @@ vtkMeshFreePointCloudReader::vtkMeshFreePointCloudReader()
 vtkMeshFreePointCloudReader::~vtkMeshFreePointCloudReader()
 {
   this->SetFileName(nullptr);
+}
+
+int vtkMeshFreePointCloudReader::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  outputVector->GetInformationObject(0)->Set(vtkAlgorithm::CAN_HANDLE_PIECE_REQUEST(), 1);
+  return 1;
+}
+
+void vtkMeshFreePointCloudReader::GetPiece(vtkInformationVector* outputVector, int& piece, int& pieces)
+{
+  vtkInformation* info = outputVector->GetInformationObject(0);
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  piece = info->Has(SDDP::UPDATE_PIECE_NUMBER()) ? info->Get(SDDP::UPDATE_PIECE_NUMBER()) : 0;
+  pieces = info->Has(SDDP::UPDATE_NUMBER_OF_PIECES()) ? info->Get(SDDP::UPDATE_NUMBER_OF_PIECES()) : 1;
+  if (pieces < 1)
+  {
+    pieces = 1;
+  }
 }
 
 vtkPolyData* vtkMeshFreePointCloudReader::PrepareOutput(vtkInformationVector* outputVector)

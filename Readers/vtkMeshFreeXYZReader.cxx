@@ -59,16 +59,23 @@ int vtkMeshFreeXYZReader::RequestData(
   {
     return 1;
   }
+  meshfree::pcd::PieceRequest request;
+  this->GetPiece(outputVector, request.Piece, request.Pieces);
   meshfree::pcd::MappedFile file;
+  request.Mapping = &file;
   meshfree::xyz::Table table;
   std::string error;
-  if (file.Open(this->FileName, error) && meshfree::xyz::LooksBinary(file.Data(), file.Size()))
+  // One piece of several: the file is only mapped, the rank reads the pages of its lines (and of the header).
+  if (file.Open(this->FileName, error, /*populate=*/request.Pieces <= 1) &&
+    meshfree::xyz::LooksBinary(file.Data(), file.Size()))
   {
     vtkErrorMacro("Cannot read '" << this->FileName
                                   << "': it holds binary data (NUL or control bytes), not a text point cloud.");
     return 1;
   }
-  if (!error.empty() || !meshfree::xyz::Parse(file.Data(), file.Size(), table, error))
+  if (!error.empty() ||
+    !(request.Pieces > 1 ? meshfree::xyz::ParsePiece(file.Data(), file.Size(), request, table, error)
+                         : meshfree::xyz::Parse(file.Data(), file.Size(), table, error)))
   {
     vtkErrorMacro("Cannot read '" << this->FileName << "': " << error);
     return 1;
@@ -107,7 +114,8 @@ int vtkMeshFreeXYZReader::RequestData(
         if (r < firstBad || (r > firstBad && finiteRow(r)))
           rows.push_back(static_cast<vtkIdType>(r));
       vtkWarningMacro("'" << this->FileName << "': dropped " << table.Rows - rows.size() << " of " << table.Rows
-                          << " points whose x, y or z is not a finite number; switch KeepInvalidPoints on to keep them.");
+                          << (request.Pieces > 1 ? " points of this piece" : " points")
+                          << " whose x, y or z is not a finite number; switch KeepInvalidPoints on to keep them.");
     }
   }
   const vtkIdType n = dropped ? static_cast<vtkIdType>(rows.size()) : static_cast<vtkIdType>(table.Rows);
@@ -146,12 +154,32 @@ int vtkMeshFreeXYZReader::RequestData(
         rgb[k] = static_cast<int>(c);
   }
   bool colors = rgb[0] >= 0 && rgb[1] >= 0 && rgb[2] >= 0;
-  for (vtkIdType i = 0; colors && i < n; ++i)
+  auto isColor = [&](const double* v) {
     for (int k = 0; k < 3; ++k)
+      if (!(v[rgb[k]] >= 0 && v[rgb[k]] <= 255 && v[rgb[k]] == std::floor(v[rgb[k]])))
+        return false;
+    return true;
+  };
+  for (vtkIdType i = 0; colors && i < n; ++i)
+    colors = isColor(row(i));
+  if (colors && request.Pieces > 1)
+  {
+    // Whether the columns become RGB depends on every kept row of the file: a piece reads the others' rows too
+    // (one at a time, nothing kept), up to the first one that is no colour.
+    auto visit = [&](const double* v) {
+      const bool finite = std::isfinite(v[xyz[0]]) && std::isfinite(v[xyz[1]]) && std::isfinite(v[xyz[2]]);
+      if (!finite && !this->KeepInvalidPoints)
+        return true; // dropped: no part of the output
+      colors = isColor(v);
+      return colors;
+    };
+    if (!meshfree::xyz::ForEachRowElsewhere(file.Data(), file.Size(), table, &file, visit, error))
     {
-      const double v = row(i)[rgb[k]];
-      colors = colors && v >= 0 && v <= 255 && v == std::floor(v);
+      vtkErrorMacro("Cannot read '" << this->FileName << "': " << error);
+      output->Initialize();
+      return 1;
     }
+  }
   if (colors)
   {
     vtkNew<vtkUnsignedCharArray> array;

@@ -11,6 +11,14 @@
  * Output: a vtkPolyData with one vertex cell per point. Rows with a NaN coordinate are dropped with a
  * warning unless KeepInvalidPoints is on. A malformed file gives an error naming the line and an empty output.
  *
+ * Pieces (MPI, see vtkMeshFreePointCloudReader): the lines after the header are cut into N byte ranges of equal
+ * size, a line belonging to the piece whose range holds its first byte; each piece parses the lines before the
+ * data (header, count, comments) and then its own lines only. The shares are contiguous, in file order, but not
+ * floor(n/N) rows each; concatenated they are the whole output bit for bit. A Leica count line makes every piece
+ * count the rows of the whole file (so a count that does not match fails on every piece); colour columns make
+ * each piece read the others' rows too (RGB only when every kept row of the file holds integers 0-255), one at a
+ * time, keeping none. A row that does not parse fails on the piece that holds it.
+ *
  * CanReadFile accepts only text whose first lines are consistent rows of numbers, so that ParaView's
  * reader factory gives real PLOT3D grids (also ".xyz") and XMol molecules to their own readers.
  *
