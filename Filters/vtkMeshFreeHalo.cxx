@@ -453,7 +453,8 @@ int vtkMeshFreeHalo::ExchangeForKNearest(vtkPointSet* local, const double* queri
     radiusFactor = 1.0;
   }
 
-  // Round 1: each rank's radius is its queries' largest distance to the k-th nearest local point.
+  // Round 1: each rank's radius is its queries' largest distance to the k-th nearest local point (an upper
+  // bound), or a smaller guess from the density, checked after the exchange.
   const vtkIdType n = local ? local->GetNumberOfPoints() : 0;
   std::vector<double> xyz(3 * static_cast<size_t>(n));
   for (vtkIdType i = 0; i < n; ++i)
@@ -488,10 +489,42 @@ int vtkMeshFreeHalo::ExchangeForKNearest(vtkPointSet* local, const double* queri
   };
   bool enough = true;
   const double far2 = farthestKth(grid, enough);
-  double radius = std::max(minimumRadius, enough ? radiusFactor * std::sqrt(far2) : 0.0);
-  const double largest = vtkMeshFreeHalo::GlobalMax(controller, enough ? radius : 0.0);
-  const bool anyShort = vtkMeshFreeHalo::GlobalMax(controller, enough ? 0.0 : 1.0) > 0.0;
-  if (!enough)
+  const double bound = enough ? radiusFactor * std::sqrt(far2) : std::numeric_limits<double>::infinity();
+  // The bound from this rank's own points is far too wide where its queries lie among other ranks' points (a
+  // cloud split by index, or an output split across the cloud's pieces). A guess from the cloud's mean density
+  // - twice the radius of a ball holding k points, in the cloud's dimension - is tried first when smaller, and
+  // checked below.
+  double localBounds[6], cloudBounds[6];
+  vtkMeshFreeHalo::FiniteBounds(xyz.data(), n, localBounds);
+  vtkMeshFreeHalo::GlobalBounds(controller, localBounds, cloudBounds);
+  double volume = 1.0, largestExtent = 0.0;
+  int dimension = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    largestExtent = std::max(largestExtent, cloudBounds[2 * a + 1] - cloudBounds[2 * a]);
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    const double extent = cloudBounds[2 * a + 1] - cloudBounds[2 * a];
+    if (extent > 1e-6 * largestExtent)
+    {
+      volume *= extent;
+      ++dimension;
+    }
+  }
+  double guess = std::numeric_limits<double>::infinity();
+  if (dimension > 0 && globalValid > 0 && kEffective > 0)
+  {
+    const double pi = 3.141592653589793;
+    const double ball = dimension == 1 ? 2.0 : (dimension == 2 ? pi : 4.0 * pi / 3.0);
+    guess = 2.0 * radiusFactor *
+      std::pow(kEffective * volume / (ball * static_cast<double>(globalValid)), 1.0 / dimension);
+  }
+  const bool guessed = std::isfinite(guess) && guess > 0.0 && guess < bound;
+  double radius = std::max(minimumRadius, guessed ? guess : (enough ? bound : 0.0));
+  const double largest = vtkMeshFreeHalo::GlobalMax(controller, enough || guessed ? radius : 0.0);
+  const bool anyShort = vtkMeshFreeHalo::GlobalMax(controller, enough && !guessed ? 0.0 : 1.0) > 0.0;
+  if (!enough && !guessed)
   {
     radius = std::max(radius, largest); // a guess, checked below
   }

@@ -24,9 +24,11 @@
  *
  * ExchangeForKNearest() sizes the halo for k-nearest-neighbour queries: each rank's radius is the largest
  * distance from one of its queries to its k-th nearest local point (an upper bound of the true one, so the
- * halo is exact in one round); a rank with fewer than k local points starts from the largest radius of the
- * others, then every rank checks its queries' k-th distance on local + halo points and a second round, agreed
- * by all ranks, widens the halo where it fell short.
+ * halo is exact in one round), or, when smaller, twice the radius of a ball holding k points at the cloud's
+ * mean density (the local bound is far too wide where a rank's queries lie among other ranks' points); a rank
+ * with fewer than k local points starts from the largest radius of the others. After a guess, every rank
+ * checks its queries' k-th distance on local + halo points and a second round, agreed by all ranks, widens the
+ * halo where it fell short.
  *
  * Every method that communicates is collective: every rank of the controller must call it, in the same order,
  * including ranks with no points. Without a controller, or with one process, no communication happens and the

@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
 """Meshless Approximation distributed over MPI ranks (benchmark, not a test).
 
-10^6 cloud points (an R3 quasi-random sequence in the unit cube, each rank generating only its own index share,
-with GlobalIds) approximated by MLS (degree 2, 20 neighbours) onto a 128^3 grid and onto a probe surface (a
-sphere of about 10^6 points, split by ParaView's pieces), with 1 rank x 2 threads (the serial path) against 2
+10^6 cloud points in the unit cube, each rank generating only its own index share (with GlobalIds): "slabs", a
+jittered lattice numbered z-major, so that index shares are slabs along z (a file sorted along z, or a cloud after
+a spatial redistribution); "scattered", an R3 quasi-random sequence, so that every share spreads over the whole
+cube (a file in random order: each rank then needs most points of its region from the others), approximated by MLS (degree 2, 20 neighbours) onto a 128^3
+grid and onto a probe surface (a sphere of about 10^6 points, split by ParaView's pieces: longitude wedges), with 1 rank x 2 threads (the serial path) against 2
 and 4 ranks x 1 thread (oversubscribed on a 2-core machine). Per configuration: the filter's wall time (the
-slowest rank, from a barrier to a barrier), each rank's peak resident memory, the cloud points a rank owns, and
-the halo points received (their sum as a fraction of the cloud). On 2 cores no speed-up is expected; what should
+slowest rank, from a barrier to a barrier), each rank's peak resident memory and its growth during the filter's
+run (peak minus the resident memory once the cloud piece is loaded; one process per case), the cloud points a
+rank owns, and the halo points received (their sum as a fraction of the cloud). On 2 cores no speed-up is expected; what should
 shrink as the ranks grow is the memory per rank and the points each rank holds.
 
   python3 Testing/Benchmarks/bench_distributed.py [--plugin path/to/MeshFree.so] [--points 1000000] [--ranks 1 2 4]
@@ -16,15 +19,17 @@ import argparse
 import glob
 import json
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
 
 CLOUD_SCRIPT = """
 import numpy as np
 from vtkmodules.util import numpy_support as ns
 from vtkmodules.vtkCommonCore import vtkPoints, VTK_ID_TYPE
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as sddp
-count = {count}
+count, kind = {count}, '{kind}'
 info = self.GetOutputInformation(0)
 piece = info.Get(sddp.UPDATE_PIECE_NUMBER()) if info.Has(sddp.UPDATE_PIECE_NUMBER()) else 0
 pieces = info.Get(sddp.UPDATE_NUMBER_OF_PIECES()) if info.Has(sddp.UPDATE_NUMBER_OF_PIECES()) else 1
@@ -32,6 +37,12 @@ lo, hi = piece * count // pieces, (piece + 1) * count // pieces
 g = 1.2207440846057596  # the R3 sequence: x_i = frac(0.5 + i (1/g, 1/g^2, 1/g^3))
 i = np.arange(lo, hi, dtype=np.float64)[:, None]
 xyz = np.mod(0.5 + i * np.array([1 / g, 1 / g ** 2, 1 / g ** 3]), 1.0)
+if kind == 'slabs':
+    # A jittered lattice numbered z-major: index shares are slabs along z, as a file sorted along z gives.
+    side = int(round(count ** (1.0 / 3.0)))
+    j = np.arange(lo, hi)
+    cell = np.column_stack([j % side, (j // side) % side, j // (side * side)]).astype(float)
+    xyz = (cell + 0.25 + 0.5 * xyz) / side
 out = self.GetPolyDataOutput()
 pts = vtkPoints()
 pts.SetData(ns.numpy_to_vtk(np.ascontiguousarray(xyz), deep=1))
@@ -61,33 +72,36 @@ def worker(args):
     ranks = controller.GetNumberOfProcesses() if controller else 1
     plugin = {"loaded": True}
     simple.LoadPlugin(args.plugin, ns=plugin)
+    rows = []
+    kind, case = args.kind, args.case
     cloud = simple.ProgrammableSource(OutputDataSetType="vtkPolyData", ScriptRequestInformation=INFO_SCRIPT,
-                                      Script=CLOUD_SCRIPT.format(count=args.points))
+                                      Script=CLOUD_SCRIPT.format(count=args.points, kind=kind))
     cloud.UpdatePipeline()
     owned = cloud.GetClientSideObject().GetOutputDataObject(0).GetNumberOfPoints()
-    rows = []
-    for case in ("grid 128^3", "probe sphere"):
-        settings = dict(Input=cloud, Method="MLS", NeighborCount=20, PointArrays=["f"])
-        if case.startswith("grid"):
-            approx = plugin["MeshlessApproximation"](SampleDimensions=[128, 128, 128], **settings)
-        else:
-            probe = simple.Sphere(Center=[0.5, 0.5, 0.5], Radius=0.4, ThetaResolution=1000, PhiResolution=1000)
-            approx = plugin["MeshlessApproximation"](Probe=probe, **settings)
-            probe.UpdatePipeline()
-        if controller:
-            controller.Barrier()
-        start = time.perf_counter()
-        approx.UpdatePipeline()
-        if controller:
-            controller.Barrier()
-        elapsed = time.perf_counter() - start
-        out = approx.GetClientSideObject().GetOutputDataObject(0)
-        field = out.GetFieldData().GetArray("HaloPoints")
-        rows.append(dict(case=case, rank=rank, ranks=ranks, seconds=elapsed, owned=owned,
-                         evaluated=out.GetNumberOfPoints(), halo=field.GetValue(0) if field else 0,
-                         rss_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0))
-        simple.Delete(approx)
-    print("ROWS " + json.dumps(rows), flush=True)
+    settings = dict(Input=cloud, Method="MLS", NeighborCount=20, PointArrays=["f"])
+    if case == "grid":
+        approx = plugin["MeshlessApproximation"](SampleDimensions=[128, 128, 128], **settings)
+    else:
+        probe = simple.Sphere(Center=[0.5, 0.5, 0.5], Radius=0.4, ThetaResolution=1000, PhiResolution=1000)
+        probe.UpdatePipeline()
+        approx = plugin["MeshlessApproximation"](Probe=probe, **settings)
+    with open("/proc/self/status") as f:
+        start_mb = next(int(line.split()[1]) for line in f if line.startswith("VmRSS:")) / 1024.0
+    if controller:
+        controller.Barrier()
+    start = time.perf_counter()
+    approx.UpdatePipeline()
+    if controller:
+        controller.Barrier()
+    elapsed = time.perf_counter() - start
+    out = approx.GetClientSideObject().GetOutputDataObject(0)
+    field = out.GetFieldData().GetArray("HaloPoints")
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    rows.append(dict(case=f"{'grid 128^3' if case == 'grid' else 'probe sphere'}, cloud in {kind}", rank=rank,
+                     ranks=ranks, seconds=elapsed, owned=owned, evaluated=out.GetNumberOfPoints(),
+                     halo=field.GetValue(0) if field else 0, rss_mb=peak_mb, growth_mb=peak_mb - start_mb))
+    with open(os.path.join(args.out, f"rank{rank}.json"), "w") as f:
+        json.dump(rows, f)
 
 
 def main():
@@ -96,6 +110,9 @@ def main():
     ap.add_argument("--points", type=int, default=1000000)
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 4])
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--out", help=argparse.SUPPRESS)
+    ap.add_argument("--kind", default="slabs", help=argparse.SUPPRESS)
+    ap.add_argument("--case", default="grid", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.plugin is None:
         here = os.path.dirname(os.path.abspath(__file__))
@@ -108,28 +125,36 @@ def main():
         return
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     table = []
-    for ranks in args.ranks:
-        threads = 2 if ranks == 1 else 1
-        run_env = dict(env, MESHFREE_NUM_THREADS=str(threads), OMP_NUM_THREADS=str(threads))
-        command = ["mpiexec", "--oversubscribe", "-n", str(ranks), "pvbatch", "--symmetric", os.path.abspath(__file__),
-                   "--worker", "--plugin", args.plugin, "--points", str(args.points)]
-        result = subprocess.run(command, env=run_env, capture_output=True, text=True)
-        rows = [r for line in result.stdout.splitlines() if line.startswith("ROWS ")
-                for r in json.loads(line[5:])]
-        if result.returncode != 0 or not rows:
-            sys.exit(f"{' '.join(command)} failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}")
-        for case in dict.fromkeys(r["case"] for r in rows):
-            mine = [r for r in rows if r["case"] == case]
-            table.append((case, ranks, threads, max(r["seconds"] for r in mine), max(r["rss_mb"] for r in mine),
-                          max(r["owned"] for r in mine), sum(r["halo"] for r in mine),
-                          max(r["evaluated"] for r in mine)))
+    for kind in ("slabs", "scattered"):
+        for case in ("grid", "probe"):
+            for ranks in args.ranks:
+                threads = 2 if ranks == 1 else 1
+                run_env = dict(env, MESHFREE_NUM_THREADS=str(threads), OMP_NUM_THREADS=str(threads))
+                out = tempfile.mkdtemp(prefix="bench_distributed_")
+                command = ["mpiexec", "--oversubscribe", "-n", str(ranks), "pvbatch", "--symmetric",
+                           os.path.abspath(__file__), "--worker", "--plugin", args.plugin, "--points",
+                           str(args.points), "--out", out, "--kind", kind, "--case", case]
+                result = subprocess.run(command, env=run_env, capture_output=True, text=True)
+                rows = []
+                for name in sorted(glob.glob(os.path.join(out, "rank*.json"))):
+                    with open(name) as f:
+                        rows += json.load(f)
+                shutil.rmtree(out, ignore_errors=True)
+                if result.returncode != 0 or not rows:
+                    sys.exit(f"{' '.join(command)} failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}")
+                table.append((rows[0]["case"], ranks, threads, max(r["seconds"] for r in rows),
+                              max(r["rss_mb"] for r in rows), max(r["growth_mb"] for r in rows),
+                              max(r["owned"] for r in rows), sum(r["halo"] for r in rows),
+                              max(r["evaluated"] for r in rows)))
     print(f"Meshless Approximation, MLS degree 2, 20 neighbours, {args.points:,} cloud points\n")
-    print("| output | ranks x threads | time (s, slowest rank) | peak memory per rank (MB, largest) | cloud points "
-          "per rank (largest) | halo points (all ranks) | halo / cloud | output points per rank (largest) |")
-    print("|---|---|---|---|---|---|---|---|")
-    for case, ranks, threads, seconds, rss, owned, halo, evaluated in table:
-        print(f"| {case} | {ranks} x {threads} | {seconds:.2f} | {rss:.0f} | {owned:,} | {halo:,.0f} | "
+    print("| output | ranks x threads | time (s, slowest rank) | peak memory per rank (MB) | growth during the "
+          "filter per rank (MB) | cloud points per rank | halo points (all ranks) | halo / cloud | output points "
+          "per rank |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for case, ranks, threads, seconds, rss, growth, owned, halo, evaluated in table:
+        print(f"| {case} | {ranks} x {threads} | {seconds:.2f} | {rss:.0f} | {growth:.0f} | {owned:,} | {halo:,.0f} | "
               f"{halo / args.points:.1%} | {evaluated:,} |")
+    print("\n(per rank: the largest over the ranks)")
 
 
 if __name__ == "__main__":
