@@ -453,8 +453,10 @@ int vtkMeshFreeHalo::ExchangeForKNearest(vtkPointSet* local, const double* queri
     radiusFactor = 1.0;
   }
 
-  // Round 1: each rank's radius is its queries' largest distance to the k-th nearest local point (an upper
-  // bound), or a smaller guess from the density, checked after the exchange.
+  // Round 1: a radius for the whole region. Twice the radius of a ball holding k points at the cloud's mean
+  // density, when the cloud has an extent: checked after the exchange. Otherwise (no extent: coincident points)
+  // the largest distance from this rank's queries to their k-th nearest own point, an upper bound (the
+  // largest of the other ranks' where this rank holds fewer than k points, checked).
   const vtkIdType n = local ? local->GetNumberOfPoints() : 0;
   std::vector<double> xyz(3 * static_cast<size_t>(n));
   for (vtkIdType i = 0; i < n; ++i)
@@ -467,33 +469,26 @@ int vtkMeshFreeHalo::ExchangeForKNearest(vtkPointSet* local, const double* queri
   const int kEffective = static_cast<int>(std::min<vtkIdType>(k, globalValid));
   std::vector<meshfree::Index> ids;
   std::vector<double> dist2;
-  // Over-estimates the true k-th distance (a subset of the cloud), so a radius from it is enough.
-  auto farthestKth = [&](const meshfree::NeighborGrid& g, bool& enough) {
+  auto finite = [](const double* x) { return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]); };
+  // The largest k-th distance over the queries (all, or those not flagged in `done`); infinity when a query
+  // has fewer than k points in g.
+  auto farthestKth = [&](const meshfree::NeighborGrid& g, const std::vector<char>* done) {
     double far2 = 0.0;
-    enough = true;
     for (vtkIdType q = 0; q < numberOfQueries && kEffective > 0; ++q)
     {
       const double* x = queries + 3 * q;
-      if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2])))
+      if (!finite(x) || (done && (*done)[q]))
       {
         continue;
       }
       if (g.FindKNearest(x, kEffective, ids, dist2) < kEffective)
       {
-        enough = false;
         return std::numeric_limits<double>::infinity();
       }
       far2 = std::max(far2, dist2.back());
     }
     return far2;
   };
-  bool enough = true;
-  const double far2 = farthestKth(grid, enough);
-  const double bound = enough ? radiusFactor * std::sqrt(far2) : std::numeric_limits<double>::infinity();
-  // The bound from this rank's own points is far too wide where its queries lie among other ranks' points (a
-  // cloud split by index, or an output split across the cloud's pieces). A guess from the cloud's mean density
-  // - twice the radius of a ball holding k points, in the cloud's dimension - is tried first when smaller, and
-  // checked below.
   double localBounds[6], cloudBounds[6];
   vtkMeshFreeHalo::FiniteBounds(xyz.data(), n, localBounds);
   vtkMeshFreeHalo::GlobalBounds(controller, localBounds, cloudBounds);
@@ -512,40 +507,58 @@ int vtkMeshFreeHalo::ExchangeForKNearest(vtkPointSet* local, const double* queri
       ++dimension;
     }
   }
-  double guess = std::numeric_limits<double>::infinity();
-  if (dimension > 0 && globalValid > 0 && kEffective > 0)
+  double radius = minimumRadius;
+  bool checked = true;
+  if (dimension > 0 && kEffective > 0)
   {
     const double pi = 3.141592653589793;
     const double ball = dimension == 1 ? 2.0 : (dimension == 2 ? pi : 4.0 * pi / 3.0);
-    guess = 2.0 * radiusFactor *
+    const double guess = 2.0 * radiusFactor *
       std::pow(kEffective * volume / (ball * static_cast<double>(globalValid)), 1.0 / dimension);
+    radius = std::max(minimumRadius, std::isfinite(guess) ? guess : largestExtent);
   }
-  const bool guessed = std::isfinite(guess) && guess > 0.0 && guess < bound;
-  double radius = std::max(minimumRadius, guessed ? guess : (enough ? bound : 0.0));
-  const double largest = vtkMeshFreeHalo::GlobalMax(controller, enough || guessed ? radius : 0.0);
-  const bool anyShort = vtkMeshFreeHalo::GlobalMax(controller, enough && !guessed ? 0.0 : 1.0) > 0.0;
-  if (!enough && !guessed)
+  else if (kEffective > 0)
   {
-    radius = std::max(radius, largest); // a guess, checked below
+    const double far2 = farthestKth(grid, nullptr);
+    const bool enough = std::isfinite(far2);
+    radius = std::max(minimumRadius, enough ? radiusFactor * std::sqrt(far2) : 0.0);
+    const double largest = vtkMeshFreeHalo::GlobalMax(controller, enough ? radius : 0.0);
+    checked = vtkMeshFreeHalo::GlobalMax(controller, enough ? 0.0 : 1.0) == 0.0;
+    radius = enough ? radius : std::max(radius, largest);
   }
   if (!this->Exchange(local, region, radius))
   {
     status = 0;
   }
-  if (!anyShort)
+  const bool check = vtkMeshFreeHalo::GlobalMax(controller, checked && dimension == 0 ? 0.0 : 1.0) > 0.0;
+  if (!check || kEffective == 0)
   {
     return status;
   }
 
-  // Check on local + halo points; a second round, agreed by all, where the k-th distance passed the radius.
+  // Check on local + halo points: a query with k points within radius / radiusFactor has all it needs (the
+  // true k-th distance is no larger); for the others, the k-th distance among local + halo points bounds the
+  // true one, and a second round, agreed by all ranks, widens the halo to it.
   vtkPoints* halo = this->Output->GetPoints();
   const double* haloXYZ = vtkDoubleArray::SafeDownCast(halo->GetData())->GetPointer(0);
   meshfree::NeighborGrid haloGrid;
   haloGrid.Build(haloXYZ, halo->GetNumberOfPoints());
-  bool complete = true;
-  const double need2 = farthestKth(haloGrid, complete);
-  const double need =
-    complete ? std::max(minimumRadius, radiusFactor * std::sqrt(need2)) : std::numeric_limits<double>::infinity();
+  std::vector<char> done(static_cast<size_t>(numberOfQueries), 0);
+  const double reach = radius / radiusFactor;
+  bool allDone = true;
+  for (vtkIdType q = 0; q < numberOfQueries; ++q)
+  {
+    const double* x = queries + 3 * q;
+    done[q] = !finite(x) || haloGrid.CountWithinRadius(x, reach) >= kEffective;
+    allDone = allDone && done[q];
+  }
+  double need = 0.0;
+  if (!allDone)
+  {
+    const double need2 = farthestKth(haloGrid, &done);
+    need = std::isfinite(need2) ? std::max(minimumRadius, radiusFactor * std::sqrt(need2))
+                                : std::numeric_limits<double>::infinity();
+  }
   const bool again = vtkMeshFreeHalo::GlobalMax(controller, need > radius ? 1.0 : 0.0) > 0.0;
   if (again)
   {

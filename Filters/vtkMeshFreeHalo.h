@@ -22,13 +22,12 @@
  * rank (rank 0's points first): the serial index when the cloud is split by index, as a reader's pieces are.
  * Ordering neighbours by global id therefore breaks distance ties exactly as the serial run does.
  *
- * ExchangeForKNearest() sizes the halo for k-nearest-neighbour queries: each rank's radius is the largest
- * distance from one of its queries to its k-th nearest local point (an upper bound of the true one, so the
- * halo is exact in one round), or, when smaller, twice the radius of a ball holding k points at the cloud's
- * mean density (the local bound is far too wide where a rank's queries lie among other ranks' points); a rank
- * with fewer than k local points starts from the largest radius of the others. After a guess, every rank
- * checks its queries' k-th distance on local + halo points and a second round, agreed by all ranks, widens the
- * halo where it fell short.
+ * ExchangeForKNearest() sizes the halo for k-nearest-neighbour queries in at most two rounds: the first radius is
+ * twice that of a ball holding k points at the cloud's mean density (over every rank); then each rank checks its
+ * queries on local + halo points - a query with k points within the radius (divided by the radius factor) has
+ * everything it needs, since the true k-th distance is no larger; for the others the k-th distance among local +
+ * halo points bounds the true one - and a second round, agreed by all ranks, widens the halo where it fell
+ * short. (A cloud without extent uses the queries' k-th distances to the rank's own points, an upper bound.)
  *
  * Every method that communicates is collective: every rank of the controller must call it, in the same order,
  * including ranks with no points. Without a controller, or with one process, no communication happens and the
