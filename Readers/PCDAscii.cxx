@@ -285,29 +285,17 @@ void CountLines(const char* b, const char* e, std::uint64_t& points, std::size_t
     b = nl ? nl + 1 : e;
   }
 }
-// CountLines over [b, e) in windows (cut at line ends), giving back each window's pages afterwards when a
-// mapping holds the data: a pass over the whole file keeps none of it.
+// CountLines over [b, e), a window at a time (ScanTextReleasing): a pass over the whole file keeps none of it.
 void CountLinesReleasing(const char* data, std::size_t b, std::size_t e, const MappedFile* mapping,
   std::uint64_t& points, std::size_t& newlines)
 {
-  constexpr std::size_t Window = std::size_t(32) << 20;
   points = 0, newlines = 0;
-  while (b < e)
-  {
-    std::size_t w = e - b > Window ? b + Window : e;
-    if (w < e)
-    {
-      const char* nl = static_cast<const char*>(std::memchr(data + w, '\n', e - w));
-      w = nl ? static_cast<std::size_t>(nl - data) + 1 : e;
-    }
+  ScanTextReleasing(data, b, e, mapping, [&](const char* begin, const char* end) {
     std::uint64_t p = 0;
     std::size_t n = 0;
-    CountLines(data + b, data + w, p, n);
+    CountLines(begin, end, p, n);
     points += p, newlines += n;
-    if (mapping)
-      mapping->Release(b, w);
-    b = w;
-  }
+  });
 }
 } // namespace
 

@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -190,6 +191,29 @@ private:
   std::size_t Length = 0;
   bool Mapped = false;
 };
+
+/// Calls scan(window_begin, window_end) over [b, e) of data in windows of about 32 MiB cut at line ends, giving back
+/// each window's pages afterwards when a mapping holds the data: a pass over a whole text file keeps none of it.
+template <class Scan>
+void ScanTextReleasing(const char* data, std::size_t b, std::size_t e, const MappedFile* mapping, Scan scan)
+{
+  constexpr std::size_t Window = std::size_t(32) << 20;
+  while (b < e)
+  {
+    std::size_t w = e - b > Window ? b + Window : e;
+    if (w < e)
+    {
+      const char* nl = static_cast<const char*>(std::memchr(data + w, '\n', e - w));
+      w = nl ? static_cast<std::size_t>(nl - data) + 1 : e;
+    }
+    scan(data + b, data + w);
+    if (mapping)
+    {
+      mapping->Release(b, w);
+    }
+    b = w;
+  }
+}
 
 /// Whole file into memory with one read; false with a message on failure.
 bool LoadFile(const std::string& path, Buffer& bytes, std::string& error);

@@ -238,27 +238,16 @@ bool ParseData(const char* b, const char* e, std::size_t columns, std::size_t li
   return true;
 }
 
-// CountRows over [b, e) of data in windows (cut at line ends), giving back the pages of each window afterwards.
+// CountRows over [b, e) of data, a window at a time (pcd::ScanTextReleasing).
 std::uint64_t CountRowsReleasing(const char* data, std::size_t b, std::size_t e, const pcd::MappedFile* mapping)
 {
-  constexpr std::size_t Window = std::size_t(32) << 20;
   std::uint64_t total = 0;
-  while (b < e)
-  {
-    std::size_t w = e - b > Window ? b + Window : e;
-    if (w < e)
-    {
-      const char* nl = static_cast<const char*>(std::memchr(data + w, '\n', e - w));
-      w = nl ? static_cast<std::size_t>(nl - data) + 1 : e;
-    }
+  pcd::ScanTextReleasing(data, b, e, mapping, [&](const char* begin, const char* end) {
     std::uint64_t rows = 0;
     std::size_t newlines = 0;
-    CountRows(data + b, data + w, rows, newlines);
+    CountRows(begin, end, rows, newlines);
     total += rows;
-    if (mapping)
-      mapping->Release(b, w);
-    b = w;
-  }
+  });
   return total;
 }
 

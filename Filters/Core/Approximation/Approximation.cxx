@@ -418,22 +418,7 @@ bool Approximator::Reach(const double* xyz, Index m, ApproximationReach& reach) 
     {
       // The lattice centres within R of the evaluation points, each fitted over its neighbours within
       // max(SupportFactor d_k, SupportFactor R) (fixed: the support radius), doubled by the fallback.
-      double umin[3], spacing = 1.0, cover = 1.0;
-      Index counts[3];
-      this->PULattice(umin, spacing, cover, counts);
-      double box[6];
-      FiniteBox(xyz, m, box);
-      const double reach2 = (cover * (1.0 + 1e-9)) * (cover * (1.0 + 1e-9));
-      const Index nodes = counts[0] * counts[1] * counts[2];
-      for (Index node = 0; node < nodes; ++node)
-      {
-        double x[3];
-        this->PUNode(umin, spacing, counts, node, x);
-        if (BoxDistance2(box, x) <= reach2)
-        {
-          reach.Queries.insert(reach.Queries.end(), x, x + 3);
-        }
-      }
+      const double cover = this->PUCentresNear(xyz, m, reach.Queries);
       reach.K = fixed ? 0 : this->Opts.NeighborCount;
       reach.Radius = 2.0 * (fixed ? R : this->Opts.SupportFactor * cover);
       reach.KFactor = fixed ? 1.0 : 2.0 * this->Opts.SupportFactor;

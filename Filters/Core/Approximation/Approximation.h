@@ -212,6 +212,9 @@ private:
   /// The PU-WLS lattice: the box (umin, umax) of the cloud in its frame relative to PUOrigin, spacing,
   /// node counts and cover radius R.
   void PULattice(double umin[3], double& spacing, double& cover, Index counts[3]) const;
+  /// The lattice centres within the cover radius R of the box of the m points xyz (in lattice order, 3 per
+  /// centre, appended to `centers` after clearing it); returns R.
+  double PUCentresNear(const double* xyz, Index m, std::vector<double>& centers) const;
   /// Position of lattice node `node` (x fastest).
   void PUNode(const double umin[3], double spacing, const Index counts[3], Index node, double x[3]) const;
   /// Sum / Max over the parts of a distributed cloud (no-ops without a partition).

@@ -120,23 +120,41 @@ void Approximator::PUNode(const double umin[3], double spacing, const Index coun
   }
 }
 
-bool Approximator::PreparePU(const double* xyz, Index m)
+double Approximator::PUCentresNear(const double* xyz, Index m, std::vector<double>& centers) const
+{
+  double umin[3], spacing = 1.0, cover = 1.0;
+  Index counts[3];
+  this->PULattice(umin, spacing, cover, counts);
+  double box[6];
+  FiniteBox(xyz, m, box);
+  const double reach2 = (cover * (1.0 + 1e-9)) * (cover * (1.0 + 1e-9));
+  centers.clear();
+  const Index nodes = counts[0] * counts[1] * counts[2];
+  for (Index node = 0; node < nodes; ++node)
+  {
+    double x[3];
+    this->PUNode(umin, spacing, counts, node, x);
+    if (BoxDistance2(box, x) <= reach2)
+    {
+      centers.insert(centers.end(), x, x + 3);
+    }
+  }
+  return cover;
+}
+
+bool Approximator::PreparePU(const double* xyz, Index count)
 {
   this->PU.reset(new PUData);
   PUData& pu = *this->PU;
   const int C = this->NumberOfComponents;
   const int k = this->Opts.NeighborCount;
-  double umin[3], spacing = 1.0, cover = 1.0;
-  Index counts[3];
-  this->PULattice(umin, spacing, cover, counts);
-  // Only the centres within R of the evaluation points' box can blend into them: the others are not fitted.
-  double box[6];
-  FiniteBox(xyz, m, box);
-  const double reach2 = (cover * (1.0 + 1e-9)) * (cover * (1.0 + 1e-9));
+  // Only the centres within R of the evaluation points can blend into them: the others are not fitted.
+  std::vector<double> centers;
+  const double cover = this->PUCentresNear(xyz, count, centers);
   pu.CoverRadius = cover;
-  const Index nodes = counts[0] * counts[1] * counts[2];
+  const Index nodes = static_cast<Index>(centers.size() / 3);
   const size_t stride = static_cast<size_t>(kMaxBasisSize) * C;
-  std::vector<double> centers(3 * nodes), supports(nodes), conditions(nodes), coefficients(stride * nodes);
+  std::vector<double> supports(nodes), conditions(nodes), coefficients(stride * nodes);
   std::vector<int> degrees(nodes, -1), fitCounts(nodes, 0);
 
   std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
@@ -144,13 +162,7 @@ bool Approximator::PreparePU(const double* xyz, Index m)
     FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
     for (Index node = begin; node < end; ++node)
     {
-      double x[3];
-      this->PUNode(umin, spacing, counts, node, x);
-      std::copy(x, x + 3, &centers[3 * node]);
-      if (BoxDistance2(box, x) > reach2)
-      {
-        continue;
-      }
+      const double* x = &centers[3 * node];
       double h = 0.0;
       if (this->Opts.SupportRadius > 0.0)
       {
