@@ -12,10 +12,14 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
+#include "vtkFieldData.h"
 
 #include "Parallel/vtkMeshFreePieces.h"
 #include "SPH/SPHFluid.h"
+#include "Common/Parallel.h"
 #include "Common/StateCache.h"
+#include "cuda/Device.h"
 
 #include <algorithm>
 #include <cmath>
@@ -35,6 +39,7 @@ struct vtkMeshFreeSPHFluid::Internals
   std::vector<double> Obstacles; // the gathered obstacle triangles, canonical; different ones empty the cache
   bool SetupFailed = false;
   std::vector<double> Times;
+  std::string BackendWarning; // the last one given: the same one is not repeated on every update
 };
 
 vtkMeshFreeSPHFluid::vtkMeshFreeSPHFluid()
@@ -254,6 +259,7 @@ int vtkMeshFreeSPHFluid::RequestData(
   long found = 0;
   const meshfree::SPHState* cached = impl.Cache.FindAtOrBefore(step, found);
   meshfree::SPHState state = *cached;
+  const std::string backend = this->SelectBackend(static_cast<vtkIdType>(state.Size()));
   const long reducedBefore = impl.Solver.ReducedSteps();
   const long last = between ? step + 1 : step; // k = step + 1 stands for the partial interval
   for (long k = found + 1; k <= last; ++k)
@@ -355,7 +361,42 @@ int vtkMeshFreeSPHFluid::RequestData(
     pd->AddArray(neighbors);
   }
   pd->SetActiveScalars("Pressure");
+  vtkNew<vtkStringArray> ran;
+  ran->SetName("Backend");
+  ran->InsertNextValue(backend);
+  output->GetFieldData()->AddArray(ran);
   return 1;
+}
+
+std::string vtkMeshFreeSPHFluid::SelectBackend(vtkIdType particles)
+{
+  // Only the CPU integrator exists so far (issue 15): Auto would take the device for a large job with a device
+  // present, but runs on the CPU like every other choice; CUDA says why it did not run on the device. The device is
+  // probed (once per process) only when it could be chosen.
+  std::string warning;
+  const bool wanted = this->Backend == BACKEND_CUDA ||
+    (this->Backend == BACKEND_AUTO && particles >= vtkMeshFreeSPHFluid::GetAutoDeviceParticles());
+  if (wanted)
+  {
+    std::string reason;
+    const bool available = meshfree::cuda::Available(&reason);
+    if (this->Backend == BACKEND_CUDA)
+    {
+      warning = available ? "SPH Fluid: Backend CUDA: this build has no device SPH integrator yet (" +
+          meshfree::cuda::DeviceName() + " unused); the CPU ran the simulation"
+                          : "SPH Fluid: Backend CUDA is not usable here (" + reason + "); the CPU ran the simulation";
+    }
+  }
+  if (warning != this->Impl->BackendWarning)
+  {
+    this->Impl->BackendWarning = warning;
+    if (!warning.empty())
+    {
+      vtkWarningMacro(<< warning);
+    }
+  }
+  const int threads = meshfree::MaxThreads();
+  return "CPU (" + std::to_string(threads) + (threads == 1 ? " thread)" : " threads)");
 }
 
 void vtkMeshFreeSPHFluid::PrintSelf(ostream& os, vtkIndent indent)
@@ -390,4 +431,5 @@ void vtkMeshFreeSPHFluid::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ComputeAcceleration: " << this->ComputeAcceleration << "\n";
   os << indent << "ComputeNeighborCount: " << this->ComputeNeighborCount << "\n";
   os << indent << "CacheSize: " << this->CacheSize << "\n";
+  os << indent << "Backend: " << this->Backend << "\n";
 }

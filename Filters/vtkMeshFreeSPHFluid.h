@@ -36,6 +36,7 @@
 #include "vtkPolyDataAlgorithm.h"
 
 #include <memory>
+#include <string>
 
 class MESHFREEFILTERS_EXPORT vtkMeshFreeSPHFluid : public vtkPolyDataAlgorithm
 {
@@ -163,6 +164,26 @@ public:
   vtkGetMacro(CacheSize, int);
   ///@}
 
+  ///@{
+  /**
+   * Which implementation runs the simulation: 0 Auto (default), 1 CPU, 2 CUDA. Auto would choose the CUDA
+   * device for jobs of at least GetAutoDeviceParticles() particles when the build has CUDA and a device is
+   * present (a guess until the crossover is measured on a GPU); CUDA where no device is usable gives a warning
+   * with the reason and the CPU result, never an error. The SPH integrator exists on the CPU only so far: every
+   * choice runs it, and the field data array `Backend` (one string, e.g. "CPU (2 threads)") says what ran. The
+   * results do not depend on it: changing it keeps the cached states.
+   */
+  enum BackendType
+  {
+    BACKEND_AUTO = 0,
+    BACKEND_CPU = 1,
+    BACKEND_CUDA = 2
+  };
+  vtkSetClampMacro(Backend, int, BACKEND_AUTO, BACKEND_CUDA);
+  vtkGetMacro(Backend, int);
+  static vtkIdType GetAutoDeviceParticles() { return 200000; }
+  ///@}
+
   /** Number of simulation steps taken by this object since its creation (for tests of the cache). */
   vtkGetMacro(StepsTaken, long);
 
@@ -208,9 +229,12 @@ protected:
   bool ComputeAcceleration = false;
   bool ComputeNeighborCount = false;
   int CacheSize = 16;
+  int Backend = BACKEND_AUTO;
   long StepsTaken = 0;
 
 private:
+  /** Applies Backend for a job of `particles` (warning when CUDA cannot run); returns what runs, for the field data. */
+  std::string SelectBackend(vtkIdType particles);
   vtkMeshFreeSPHFluid(const vtkMeshFreeSPHFluid&) = delete;
   void operator=(const vtkMeshFreeSPHFluid&) = delete;
 

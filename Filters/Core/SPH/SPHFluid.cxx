@@ -3,6 +3,7 @@
 #include "SPH/SPHFluid.h"
 
 #include "Common/Parallel.h"
+#include "SPH/SPHDensity.h"
 
 #include <algorithm>
 #include <cmath>
@@ -120,35 +121,19 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   double* pressureTerm = this->PressureTerm.data();
   double* inverseDensity = this->InverseDensity.data();
 
-  // Density (5.32) and pressure (5.40 / Tait).
+  // Density (5.32: SPH/SPHDensity.h, the function the CUDA launcher runs too) and pressure (5.40 / Tait).
+  SPHDensityConstants densityConstants;
+  densityConstants.H = h;
+  densityConstants.H2 = h2;
+  densityConstants.Mass = m;
+  densityConstants.DensityNorm = densityNorm;
+  densityConstants.SpikyDensity = this->SpikyDensity ? 1 : 0;
   ParallelFor(
     n, 512,
     [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
-        const double* xi = x + 3 * i;
-        double fluidSum = this->DensityShape(0.0); // itself
-        for (Index s = fs[i]; s < fs[i + 1]; ++s)
-        {
-          const double* xj = x + 3 * fn[s];
-          const double dx = xi[0] - xj[0], dy = xi[1] - xj[1], dz = xi[2] - xj[2];
-          const double r2 = dx * dx + dy * dy + dz * dz;
-          if (r2 < h2)
-          {
-            fluidSum += this->DensityShape(r2);
-          }
-        }
-        for (Index s = bs[i]; s < bs[i + 1]; ++s)
-        {
-          const double* xb = bx + 3 * bn[s];
-          const double dx = xi[0] - xb[0], dy = xi[1] - xb[1], dz = xi[2] - xb[2];
-          const double r2 = dx * dx + dy * dy + dz * dz;
-          if (r2 < h2)
-          {
-            fluidSum += this->DensityShape(r2); // dummies weigh like fluid particles
-          }
-        }
-        rho[i] = densityNorm * m * fluidSum;
+        rho[i] = SPHParticleDensity(i, x, fs, fn, bx, bs, bn, densityConstants);
         pressure[i] = this->PressureOf(rho[i]);
         pressureTerm[i] = pressure[i] / (rho[i] * rho[i]);
         inverseDensity[i] = 1.0 / rho[i];

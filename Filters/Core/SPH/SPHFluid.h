@@ -70,6 +70,7 @@
 #define meshfree_SPHFluid_h
 
 #include "Common/NeighborGrid.h"
+#include "SPH/SPHDensity.h"
 
 #include <cmath>
 #include <cstdint>
@@ -216,16 +217,7 @@ private:
   double K = 0.0, C0 = 0.0, TaitB = 0.0;
   double Nu = 0.0;
   // Density W = DensityNorm DensityShape(r^2); grad W = -GradientNorm GradientShape(r^2, r) r_vec.
-  double DensityShape(double r2) const
-  {
-    if (this->SpikyDensity)
-    {
-      const double u = this->H - std::sqrt(r2);
-      return u * u * u;
-    }
-    const double q = this->H2 - r2;
-    return q * q * q;
-  }
+  double DensityShape(double r2) const { return SPHDensityShape(r2, this->H, this->H2, this->SpikyDensity ? 1 : 0); }
   double GradientShape(double r2, double r) const
   {
     if (this->SpikyGradient)

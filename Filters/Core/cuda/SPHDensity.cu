@@ -1,0 +1,119 @@
+// The CUDA launcher of the SPH density pass (cuda/SPHDensity.h).
+#include "cuda/SPHDensity.h"
+
+#include "cuda/Device.h"
+
+#include <cuda_runtime.h>
+
+#include <vector>
+
+namespace meshfree
+{
+namespace cuda
+{
+namespace
+{
+constexpr int BlockSize = 128;
+
+__global__ void DensityKernel(std::int64_t n, const double* x, const std::int64_t* fluidStart,
+  const std::int32_t* fluidNeighbors, const double* boundaryX, const std::int64_t* boundaryStart,
+  const std::int32_t* boundaryNeighbors, SPHDensityConstants constants, double* rho)
+{
+  const std::int64_t i = static_cast<std::int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < n)
+  {
+    rho[i] = SPHParticleDensity(i, x, fluidStart, fluidNeighbors, boundaryX, boundaryStart, boundaryNeighbors,
+      constants);
+  }
+}
+
+bool Check(cudaError_t status, const char* what, std::string* error)
+{
+  if (status == cudaSuccess)
+  {
+    return true;
+  }
+  if (error)
+  {
+    *error = std::string(what) + ": " + cudaGetErrorName(status) + " (" + cudaGetErrorString(status) + ")";
+  }
+  return false;
+}
+
+/// A device array freed on scope exit.
+template <class T>
+struct DeviceArray
+{
+  T* Data = nullptr;
+  ~DeviceArray() { cudaFree(this->Data); }
+  bool Upload(const T* host, std::int64_t count, std::string* error)
+  {
+    const std::size_t bytes = sizeof(T) * static_cast<std::size_t>(count > 0 ? count : 1);
+    if (!Check(cudaMalloc(&this->Data, bytes), "cudaMalloc", error))
+    {
+      return false;
+    }
+    return count == 0 || Check(cudaMemcpy(this->Data, host, sizeof(T) * count, cudaMemcpyHostToDevice), "cudaMemcpy",
+                            error);
+  }
+};
+} // namespace
+
+bool SPHDensityOnDevice(std::int64_t n, const double* x, const std::int64_t* fluidStart,
+  const std::int32_t* fluidNeighbors, const double* boundaryX, const std::int64_t* boundaryStart,
+  const std::int32_t* boundaryNeighbors, const SPHDensityConstants& constants, double* rho, std::string* error)
+{
+  std::string reason;
+  if (!Available(&reason))
+  {
+    if (error)
+    {
+      *error = reason;
+    }
+    return false;
+  }
+  if (n <= 0)
+  {
+    return true;
+  }
+  const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
+  DensityKernel<<<static_cast<unsigned>(blocks), BlockSize>>>(
+    n, x, fluidStart, fluidNeighbors, boundaryX, boundaryStart, boundaryNeighbors, constants, rho);
+  return Check(cudaGetLastError(), "density kernel launch", error) &&
+    Check(cudaDeviceSynchronize(), "density kernel", error);
+}
+
+bool SPHDensityFromHost(std::int64_t n, const double* x, const std::int64_t* fluidStart,
+  const std::int32_t* fluidNeighbors, std::int64_t nb, const double* boundaryX, const std::int64_t* boundaryStart,
+  const std::int32_t* boundaryNeighbors, const SPHDensityConstants& constants, double* rho, std::string* error)
+{
+  std::string reason;
+  if (!Available(&reason))
+  {
+    if (error)
+    {
+      *error = reason;
+    }
+    return false;
+  }
+  if (n <= 0)
+  {
+    return true;
+  }
+  DeviceArray<double> dx, dbx, drho;
+  DeviceArray<std::int64_t> dfs, dbs;
+  DeviceArray<std::int32_t> dfn, dbn;
+  const bool uploaded = dx.Upload(x, 3 * n, error) && dfs.Upload(fluidStart, n + 1, error) &&
+    dfn.Upload(fluidNeighbors, fluidStart[n], error) && dbx.Upload(boundaryX, 3 * nb, error) &&
+    dbs.Upload(boundaryStart, n + 1, error) && dbn.Upload(boundaryNeighbors, boundaryStart[n], error) &&
+    Check(cudaMalloc(&drho.Data, sizeof(double) * n), "cudaMalloc", error);
+  if (!uploaded ||
+    !SPHDensityOnDevice(n, dx.Data, dfs.Data, dfn.Data, dbx.Data, dbs.Data, dbn.Data, constants, drho.Data, error))
+  {
+    return false;
+  }
+  return Check(cudaMemcpy(rho, drho.Data, sizeof(double) * n, cudaMemcpyDeviceToHost), "cudaMemcpy", error);
+}
+
+} // namespace cuda
+} // namespace meshfree
