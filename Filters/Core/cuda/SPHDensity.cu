@@ -57,19 +57,28 @@ struct DeviceArray
                             error);
   }
 };
+/// Whether a device is there to run on; otherwise `error` gets the reason.
+bool Usable(std::string* error)
+{
+  std::string reason;
+  if (Available(&reason))
+  {
+    return true;
+  }
+  if (error)
+  {
+    *error = reason;
+  }
+  return false;
+}
 } // namespace
 
 bool SPHDensityOnDevice(std::int64_t n, const double* x, const std::int64_t* fluidStart,
   const std::int32_t* fluidNeighbors, const double* boundaryX, const std::int64_t* boundaryStart,
   const std::int32_t* boundaryNeighbors, const SPHDensityConstants& constants, double* rho, std::string* error)
 {
-  std::string reason;
-  if (!Available(&reason))
+  if (!Usable(error))
   {
-    if (error)
-    {
-      *error = reason;
-    }
     return false;
   }
   if (n <= 0)
@@ -87,13 +96,8 @@ bool SPHDensityFromHost(std::int64_t n, const double* x, const std::int64_t* flu
   const std::int32_t* fluidNeighbors, std::int64_t nb, const double* boundaryX, const std::int64_t* boundaryStart,
   const std::int32_t* boundaryNeighbors, const SPHDensityConstants& constants, double* rho, std::string* error)
 {
-  std::string reason;
-  if (!Available(&reason))
+  if (!Usable(error))
   {
-    if (error)
-    {
-      *error = reason;
-    }
     return false;
   }
   if (n <= 0)
