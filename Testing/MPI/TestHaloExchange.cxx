@@ -5,6 +5,7 @@
 // box test's margin of 1e-12 relative), coordinates, arrays and global ids intact, owned points first.
 // k-nearest: every query's k nearest points of the whole cloud are in the halo, also when a rank holds fewer
 // than k points (second round). Empty pieces and a one-point cloud must not hang.
+#include "MPITestSupport.h"
 #include "vtkDoubleArray.h"
 #include "vtkIdTypeArray.h"
 #include "vtkMPIController.h"
@@ -25,29 +26,9 @@
 
 namespace
 {
-int Rank = 0;
-int Failures = 0;
-
-void Check(bool ok, const char* what, double value = 0.0)
-{
-  if (!ok)
-  {
-    std::printf("ERROR: rank %d: %s (%g)\n", Rank, what, value);
-    ++Failures;
-  }
-}
-
-std::vector<double> RandomCloud(int n, unsigned seed)
-{
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> xyz(3 * n);
-  for (double& v : xyz)
-  {
-    v = u(rng);
-  }
-  return xyz;
-}
+using mpitest::Check;
+using mpitest::Failures;
+using mpitest::Rank;
 
 /// The points `ids` of the global cloud as a vtkPolyData with arrays "f" (1 component) and "g" (3), and the
 /// global ids as the GlobalIds attribute when `withIds`.
@@ -192,7 +173,7 @@ int main(int argc, char* argv[])
   // 1. A random cloud split into slabs along x (spatially coherent pieces), global ids given by the input.
   {
     const int n = 4000;
-    const std::vector<double> xyz = RandomCloud(n, 7);
+    const std::vector<double> xyz = mpitest::RandomPoints(n, 7);
     std::vector<vtkIdType> mine;
     for (vtkIdType id = 0; id < n; ++id)
     {
@@ -253,7 +234,7 @@ int main(int argc, char* argv[])
   //    neighbours' points: a probe region elsewhere, and an infinite radius (the whole cloud).
   {
     const int n = 1000;
-    const std::vector<double> xyz = RandomCloud(n, 11);
+    const std::vector<double> xyz = mpitest::RandomPoints(n, 11);
     std::vector<vtkIdType> mine;
     for (vtkIdType id = Rank * n / size; id < (Rank + 1) * n / size; ++id)
     {
@@ -272,7 +253,7 @@ int main(int argc, char* argv[])
   // 3. Tiny clouds: fewer points than ranks, one point, none; k larger than the cloud; k-NN second round.
   for (int n : { 5, 1, 0 })
   {
-    const std::vector<double> xyz = RandomCloud(n, 3);
+    const std::vector<double> xyz = mpitest::RandomPoints(n, 3);
     std::vector<vtkIdType> mine;
     for (vtkIdType id = Rank * n / size; id < (Rank + 1) * n / size; ++id)
     {

@@ -6,6 +6,7 @@
 // one rank) gives: the kernel lists its neighbours by distance, so the sums run in the same order and the values
 // agree bit for bit (checked to 1e-12 of the range, reported exactly). Also with a rank that holds no source
 // point and one that holds no probe point.
+#include "MPITestSupport.h"
 #include "vtkDoubleArray.h"
 #include "vtkMPIController.h"
 #include "vtkMeshFreeHalo.h"
@@ -24,29 +25,10 @@
 
 namespace
 {
-int Rank = 0;
-int Failures = 0;
-
-void Check(bool ok, const char* what, double value = 0.0)
-{
-  if (!ok)
-  {
-    std::printf("ERROR: rank %d: %s (%g)\n", Rank, what, value);
-    ++Failures;
-  }
-}
-
-std::vector<double> RandomPoints(int n, unsigned seed, double lo, double hi)
-{
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(lo, hi);
-  std::vector<double> xyz(3 * static_cast<size_t>(n));
-  for (double& v : xyz)
-  {
-    v = u(rng);
-  }
-  return xyz;
-}
+using mpitest::Check;
+using mpitest::Failures;
+using mpitest::RandomPoints;
+using mpitest::Rank;
 
 /// Points [begin, end) of xyz as a vtkPolyData, with the field f when `withField`.
 vtkSmartPointer<vtkPolyData> Cloud(const std::vector<double>& xyz, vtkIdType begin, vtkIdType end, bool withField)
