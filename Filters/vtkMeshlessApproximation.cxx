@@ -610,42 +610,41 @@ int vtkMeshlessApproximation::RequestData(
     nonFinite += (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2])) ? 0 : 1;
   }
 
+  // Distributed: the halo, every point of the other ranks' pieces the evaluation here reads (in one or two
+  // rounds), then the cloud again with it. LS reads nothing but the global sums the first SetCloud made.
+  this->HaloPoints = 0;
+  meshfree::ApproximationReach reach;
   if (controller)
   {
-    // The halo: every point of the other ranks' pieces the evaluation here reads, in one or two rounds.
-    meshfree::ApproximationReach reach;
     approx.Reach(eval.data(), m, reach);
+  }
+  if (controller && !reach.Global)
+  {
     vtkDataArray* inputIds = inPD->GetGlobalIds();
     vtkSmartPointer<vtkPolyData> cloud =
       CloudData(xyz, values, columns, volumes, inputIds && n > 0 ? inputIds : nullptr);
     vtkNew<vtkMeshFreeHalo> halo;
     halo->SetController(controller);
-    if (!reach.Global)
+    ExchangeReach(halo, cloud, reach.Queries, reach.K, reach.Radius, reach.KFactor);
+    if (reach.SecondLevel)
     {
-      ExchangeReach(halo, cloud, reach.Queries, reach.K, reach.Radius, reach.KFactor);
-      if (reach.SecondLevel)
+      // The neighbours' own neighbourhoods (SPH volumes): every point found is a query.
+      vtkPoints* found = halo->GetOutput()->GetPoints();
+      std::vector<double> queries(3 * static_cast<size_t>(found->GetNumberOfPoints()));
+      for (vtkIdType i = 0; i < found->GetNumberOfPoints(); ++i)
       {
-        // The neighbours' own neighbourhoods (SPH volumes): every point found is a query.
-        vtkPoints* found = halo->GetOutput()->GetPoints();
-        std::vector<double> queries(3 * static_cast<size_t>(found->GetNumberOfPoints()));
-        for (vtkIdType i = 0; i < found->GetNumberOfPoints(); ++i)
-        {
-          found->GetPoint(i, &queries[3 * i]);
-        }
-        ExchangeReach(halo, cloud, queries, reach.K2, reach.Radius2, 1.0);
+        found->GetPoint(i, &queries[3 * i]);
       }
+      ExchangeReach(halo, cloud, queries, reach.K2, reach.Radius2, 1.0);
     }
     // Local and halo points ordered by global id (ties break as in the serial run), own points flagged.
-    vtkPolyData* extended = reach.Global ? cloud.Get() : halo->GetOutput();
+    vtkPolyData* extended = halo->GetOutput();
     const vtkIdType total = extended->GetNumberOfPoints();
-    const vtkIdType owned = reach.Global ? n : halo->GetNumberOfOwnedPoints();
+    const vtkIdType owned = halo->GetNumberOfOwnedPoints();
     std::vector<vtkIdType> order(total);
     std::iota(order.begin(), order.end(), vtkIdType(0));
-    if (!reach.Global)
-    {
-      const vtkIdType* ids = halo->GetGlobalIds()->GetPointer(0);
-      std::stable_sort(order.begin(), order.end(), [ids](vtkIdType a, vtkIdType b) { return ids[a] < ids[b]; });
-    }
+    const vtkIdType* ids = halo->GetGlobalIds()->GetPointer(0);
+    std::stable_sort(order.begin(), order.end(), [ids](vtkIdType a, vtkIdType b) { return ids[a] < ids[b]; });
     vtkDataArray* table = extended->GetPointData()->GetArray("values");
     vtkDataArray* v = extended->GetPointData()->GetArray("volumes");
     std::vector<unsigned char> own(total);
@@ -668,10 +667,6 @@ int vtkMeshlessApproximation::RequestData(
     partition.Owned = own.data();
     approx.SetCloud(xyz2.data(), total, values2.data(), columns, useVolumes ? volumes2.data() : nullptr, &partition);
     this->HaloPoints = total - owned;
-  }
-  else
-  {
-    this->HaloPoints = 0;
   }
 
   const double* cloudBounds = approx.CloudBounds();
