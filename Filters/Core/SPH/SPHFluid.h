@@ -71,6 +71,7 @@
 
 #include "Common/NeighborGrid.h"
 #include "SPH/SPHDensity.h"
+#include "SPH/SPHPhysics.h"
 
 #include <cmath>
 #include <cstdint>
@@ -205,8 +206,7 @@ private:
   void Enforce(SPHState& state, Index begin, Index end) const;
   bool NearBoundary(const double* x) const;
   bool NearObstacle(const double* x) const;
-  double PressureOf(double density) const;
-  double DensityOf(double pressure) const; // inverse of the equation of state for p >= 0
+  void FillConstants(); // Physics from the members below, at the end of Setup()
 
   SPHParameters Params;
   std::vector<std::string> WarningList;
@@ -220,12 +220,7 @@ private:
   double DensityShape(double r2) const { return SPHDensityShape(r2, this->H, this->H2, this->SpikyDensity ? 1 : 0); }
   double GradientShape(double r2, double r) const
   {
-    if (this->SpikyGradient)
-    {
-      return (this->H - r) * (this->H - r) / r;
-    }
-    const double q = this->H2 - r2;
-    return q * q;
+    return SPHGradientShape(r2, r, this->H, this->H2, this->SpikyGradient ? 1 : 0);
   }
   bool SpikyDensity = false, SpikyGradient = false;
   double DensityNorm = 0.0, DensityCorrection = 1.0, CompressionResponse = 1.0;
@@ -233,6 +228,7 @@ private:
   double Poly6 = 0.0;                         // colour field, lattice-normalised
   double ViscLap = 0.0, ViscCorrection = 1.0; // lap W = ViscLap (h - r)
   double WallMargin = 0.0;
+  SPHConstants Physics; // the above as the shared per-particle functions (SPH/SPHPhysics.h) take them
 
   // Boundary (dummy) particles, static; obstacle surface samples with outward normals; their grids.
   std::vector<double> BoundaryPosition;
