@@ -118,12 +118,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
 
   // Density (5.32: SPH/SPHDensity.h, the function the CUDA launcher runs too) and pressure (5.40 / Tait).
   const SPHConstants& c = this->Physics;
-  SPHDensityConstants densityConstants;
-  densityConstants.H = c.H;
-  densityConstants.H2 = c.H2;
-  densityConstants.Mass = c.Mass;
-  densityConstants.DensityNorm = c.DensityNorm;
-  densityConstants.SpikyDensity = c.SpikyDensity;
+  const SPHDensityConstants densityConstants = SPHDensityConstantsOf(c);
   ParallelFor(
     n, 512,
     [&](Index begin, Index end) {
@@ -270,12 +265,12 @@ void SPHFluid::Reorder(SPHState& state)
   // Density and pressure are recomputed by the next force evaluation.
 }
 
-double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
+SPHExtremes SPHFluid::Extremes(const SPHState& state) const
 {
   const Index n = state.Size();
   SPHExtremes identity;
   identity.Rho = this->Params.RestDensity;
-  const SPHExtremes e = ParallelReduce(
+  return ParallelReduce(
     n, 4096, identity,
     [&](Index begin, Index end) {
       SPHExtremes m = identity;
@@ -290,7 +285,58 @@ double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
       return x;
     },
     ParallelThreshold);
-  return SPHStableStep(e, lambda, this->Physics);
+}
+
+double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
+{
+  return SPHStableStep(this->Extremes(state), lambda, this->Physics);
+}
+
+bool SPHFluid::ChooseStep(const SPHExtremes& e, double time, double targetTime, long steps, double& dt, bool& last)
+{
+  const SPHParameters& p = this->Params;
+  const double remaining = targetTime - time;
+  if (p.CFLNumber > 0.0)
+  {
+    dt = std::min(p.TimeStep, SPHStableStep(e, std::min(p.CFLNumber, StabilityLambda), this->Physics));
+  }
+  else
+  {
+    const double stable = SPHStableStep(e, StabilityLambda, this->Physics);
+    dt = p.TimeStep;
+    if (dt > stable)
+    {
+      dt = stable;
+      ++this->ReducedStepCount;
+    }
+  }
+  if (!(dt > 0.0) || !std::isfinite(dt))
+  {
+    std::ostringstream s;
+    s << "the simulation became unstable (non-finite velocity, acceleration or density) at t = " << time;
+    this->Error = s.str();
+    return false;
+  }
+  last = false;
+  if (dt >= remaining)
+  {
+    dt = remaining;
+    last = true;
+  }
+  else if (dt > 0.5 * remaining)
+  {
+    dt = 0.5 * remaining; // two equal steps rather than a sliver at the end
+  }
+  if (remaining / dt > static_cast<double>(p.MaximumStepsPerInterval - steps))
+  {
+    std::ostringstream s;
+    s << "the time step collapsed to " << dt << " s at t = " << time << ": reaching t = " << targetTime
+      << " would take more than " << p.MaximumStepsPerInterval
+      << " steps (is GasStiffness or the velocity absurdly large?)";
+    this->Error = s.str();
+    return false;
+  }
+  return true;
 }
 
 SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const ProgressFunction& progress)
@@ -302,55 +348,31 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
     this->Error = "the target time lies before the state's time";
     return Status::Failed;
   }
+  this->LastBackend = SPHBackend::CPU;
+  this->DeviceNote.clear();
+  if (this->RequestedBackend == SPHBackend::CUDA)
+  {
+    bool declined = false;
+    const Status status = this->AdvanceOnDevice(state, targetTime, progress, declined);
+    if (!declined)
+    {
+      this->LastBackend = SPHBackend::CUDA;
+      return status;
+    }
+  }
   const Index n = state.Size();
   long steps = 0;
   while (state.Time < targetTime)
   {
-    const double remaining = targetTime - state.Time;
     if (n == 0)
     {
       state.Time = targetTime;
       break;
     }
     double dt;
-    if (p.CFLNumber > 0.0)
+    bool last;
+    if (!this->ChooseStep(this->Extremes(state), state.Time, targetTime, steps, dt, last))
     {
-      dt = std::min(p.TimeStep, this->StableTimeStep(state, std::min(p.CFLNumber, StabilityLambda)));
-    }
-    else
-    {
-      const double stable = this->StableTimeStep(state, StabilityLambda);
-      dt = p.TimeStep;
-      if (dt > stable)
-      {
-        dt = stable;
-        ++this->ReducedStepCount;
-      }
-    }
-    if (!(dt > 0.0) || !std::isfinite(dt))
-    {
-      std::ostringstream s;
-      s << "the simulation became unstable (non-finite velocity, acceleration or density) at t = " << state.Time;
-      this->Error = s.str();
-      return Status::Failed;
-    }
-    bool last = false;
-    if (dt >= remaining)
-    {
-      dt = remaining;
-      last = true;
-    }
-    else if (dt > 0.5 * remaining)
-    {
-      dt = 0.5 * remaining; // two equal steps rather than a sliver at the end
-    }
-    if (remaining / dt > static_cast<double>(p.MaximumStepsPerInterval - steps))
-    {
-      std::ostringstream s;
-      s << "the time step collapsed to " << dt << " s at t = " << state.Time << ": reaching t = " << targetTime
-        << " would take more than " << p.MaximumStepsPerInterval
-        << " steps (is GasStiffness or the velocity absurdly large?)";
-      this->Error = s.str();
       return Status::Failed;
     }
 

@@ -76,11 +76,23 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace meshfree
 {
+namespace cuda
+{
+class SPHDevice;
+}
+
+/// Which implementation runs Advance().
+enum class SPHBackend
+{
+  CPU = 0, ///< the oneTBB loops of SPHFluid.cxx
+  CUDA = 1 ///< the CUDA device (cuda/SPHDevice.h), where usable; otherwise the CPU (see BackendNote())
+};
 
 enum class SPHEquationOfState
 {
@@ -172,6 +184,23 @@ public:
   /// Advances `state` to exactly `targetTime` (>= state.Time).
   Status Advance(SPHState& state, double targetTime, const ProgressFunction& progress = nullptr);
 
+  ///@{
+  /// The implementation Advance() asks for (default CPU). With CUDA, Advance() keeps the particles on the
+  /// device from its start to its end and gives the same bits as the CPU (SPH/SPHPhysics.h), except for the
+  /// Tait equation of state, whose wall-dummy density needs a pow (a few ulps; see SPHPhysics.h). The device
+  /// declines, and the CPU runs, when it cannot: a build without CUDA, no usable device, a scene with obstacles
+  /// (their projection is CPU code), 2^31 particles or more, or a CUDA failure during the call (the CPU then
+  /// redoes the whole call from its start). UsedBackend() says what ran the last Advance(), BackendNote() why the
+  /// device declined it (empty when it ran or was not asked for).
+  void SetBackend(SPHBackend backend) { this->RequestedBackend = backend; }
+  SPHBackend Backend() const { return this->RequestedBackend; }
+  SPHBackend UsedBackend() const { return this->LastBackend; }
+  const std::string& BackendNote() const { return this->DeviceNote; }
+  /// Why the device cannot run this setup (after Setup()), or empty when it can (a device is present, no
+  /// obstacles). Probes the CUDA runtime once per process.
+  std::string DeviceDeclineReason() const;
+  ///@}
+
   /// Number of fluid neighbours (within h, itself excluded) of every particle of `state`.
   std::vector<int> NeighborCounts(const SPHState& state);
 
@@ -200,6 +229,13 @@ public:
   double StableTimeStep(const SPHState& state, double lambda) const;
 
 private:
+  /// The step of the state whose CFL maxima are `e` at `time` towards `targetTime`, `steps` already taken in
+  /// this call (TimeStep, CFL, the stability reduction, the landing on targetTime); false with Error set when the
+  /// step collapsed or the state is unstable.
+  bool ChooseStep(const SPHExtremes& e, double time, double targetTime, long steps, double& dt, bool& last);
+  SPHExtremes Extremes(const SPHState& state) const;
+  /// Advance() on the device (SPHFluidDevice.cxx); declined = true (state untouched) when the CPU must run it.
+  Status AdvanceOnDevice(SPHState& state, double targetTime, const ProgressFunction& progress, bool& declined);
   void ComputeAccelerations(SPHState& state);
   void BuildNeighborLists(const SPHState& state, bool withBoundary);
   void Reorder(SPHState& state);
@@ -239,6 +275,13 @@ private:
   std::vector<double> ObstaclePosition, ObstacleNormal;
   NeighborGrid ObstacleGrid;
   double ObstacleBox[6] = { 0, -1, 0, -1, 0, -1 };
+
+  // Back end: asked for, used by the last Advance(), why the device declined; the device state (shared_ptr:
+  // a copy of the solver shares it, and re-uploads its own state on every Advance()).
+  SPHBackend RequestedBackend = SPHBackend::CPU;
+  SPHBackend LastBackend = SPHBackend::CPU;
+  std::string DeviceNote;
+  std::shared_ptr<cuda::SPHDevice> Device;
 
   // Per-step scratch.
   NeighborGrid Grid;

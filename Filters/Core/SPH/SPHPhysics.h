@@ -53,6 +53,18 @@ struct SPHConstants
   double ObstacleBox[6] = { 0.0, -1.0, 0.0, -1.0, 0.0, -1.0 }; ///< bounds of the obstacle samples (empty: none)
 };
 
+/// The density sum's constants (SPH/SPHDensity.h) of these.
+MESHFREE_HD inline SPHDensityConstants SPHDensityConstantsOf(const SPHConstants& c)
+{
+  SPHDensityConstants d;
+  d.H = c.H;
+  d.H2 = c.H2;
+  d.Mass = c.Mass;
+  d.DensityNorm = c.DensityNorm;
+  d.SpikyDensity = c.SpikyDensity;
+  return d;
+}
+
 /// Equation of state, clamped at 0: Ideal p = K (rho - rho0), Tait p = B ((rho/rho0)^7 - 1) (the power as products).
 MESHFREE_HD inline double SPHPressureOf(double rho, const SPHConstants& c)
 {

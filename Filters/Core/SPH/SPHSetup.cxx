@@ -393,6 +393,7 @@ void SPHFluid::FillConstants()
     c.ObstacleBox[a] = this->ObstacleBox[a];
   }
   c.WallMargin = this->WallMargin;
+  this->Device.reset(); // the device copy of the constants and dummies is made again on the next device run
 }
 
 bool SPHFluid::NearBoundary(const double* x) const
