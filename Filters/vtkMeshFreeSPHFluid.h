@@ -172,8 +172,7 @@ public:
    * the CPU result, never an error. Auto chooses the device for jobs of at least GetAutoDeviceParticles()
    * particles when it can run them (the threshold is a guess until the crossover is measured on a GPU), the
    * CPU otherwise. The field data array `Backend` (one string) says what ran, e.g. "CPU (oneTBB, 2 threads)" or
-   * "CUDA (NVIDIA H200)". The results do not depend on it (bit for bit, except with the Tait equation of
-   * state, where the device's pow may differ from the CPU's in the last bits): changing it keeps the cached
+   * "CUDA (NVIDIA H200)". The results do not depend on it (bit for bit): changing it keeps the cached
    * states.
    */
   enum BackendType

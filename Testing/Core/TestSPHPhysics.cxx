@@ -81,6 +81,20 @@ TEST(SPHPhysics, EquationsOfStateAndInverse)
   EXPECT_NEAR(inverse, 1.0 / 1010.0, 1e-18);
 }
 
+TEST(SPHPhysics, SeventhRoot)
+{
+  // The Tait inverse's root (Newton on +, *, /): within 2 ulp of pow, exact where the root is.
+  EXPECT_EQ(meshfree::SPHSeventhRoot(1.0), 1.0);
+  EXPECT_EQ(meshfree::SPHSeventhRoot(128.0), 2.0);
+  EXPECT_EQ(meshfree::SPHSeventhRoot(2187.0), 3.0);
+  for (double z = 1.0; z < 300.0; z = z * 1.0137 + 1e-3)
+  {
+    const double want = std::pow(z, 1.0 / 7.0);
+    EXPECT_NEAR(meshfree::SPHSeventhRoot(z), want, 4.5e-16 * want) << z;
+  }
+  EXPECT_NEAR(meshfree::SPHSeventhRoot(1e12), std::pow(1e12, 1.0 / 7.0), 1e-15 * std::pow(1e12, 1.0 / 7.0));
+}
+
 TEST(SPHPhysics, PairForceByHand)
 {
   SPHConstants c = Water(false);

@@ -1,4 +1,4 @@
-"""SPH Fluid Backend: CUDA gives the CPU's particles bit for bit (Ideal equation of state), on the device where one is
+"""SPH Fluid Backend: CUDA gives the CPU's particles bit for bit, on the device where one is
 usable (field data Backend "CUDA (...)", no warning), else on the CPU with a warning saying why; Auto is the default
 (the CPU for this small job), and field data Backend says what ran."""
 import os
@@ -23,7 +23,7 @@ def fluid(**backend):
     src = SPHFluid(Dimension=2, ParticleSpacing=0.01, FluidBounds=[0, 0.1, 0, 0, 0, 0.2],
                    DomainBounds=[0, 0.4, 0, 0, 0, 0.3], Gravity=[0, 0, -9.81], TimeStep=0.002, CFLNumber=0.25,
                    EndTime=0.05, OutputInterval=0.025, **backend)
-    src.EquationOfState = 'Ideal'  # Tait's dummy density needs a pow: the device may differ in the last bits
+    src.EquationOfState = 'Tait'
     return src
 
 

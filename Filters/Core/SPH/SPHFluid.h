@@ -66,6 +66,11 @@
 // particles of a cell; rows identical to per-particle queries), then every pass streams through the lists. Every ReorderInterval steps the particle arrays are permuted into
 // the grid's Z-order so that neighbours are close in memory. Everything the future depends on is in SPHState, so
 // a state restored from a cache continues bit-identically, whatever the number of threads.
+//
+// Back ends (SetBackend): the per-particle arithmetic is shared MESHFREE_HD code (SPH/SPHPhysics.h,
+// SPH/SPHDensity.h); the CPU loops (SPHFluid.cxx) feed it CSR neighbour rows, the CUDA integrator
+// (cuda/SPHDevice.h, driven by SPHFluidDevice.cxx) the same neighbours in the same order from a grid rebuilt on the
+// device, so both give the same bits.
 #ifndef meshfree_SPHFluid_h
 #define meshfree_SPHFluid_h
 
@@ -186,8 +191,7 @@ public:
 
   ///@{
   /// The implementation Advance() asks for (default CPU). With CUDA, Advance() keeps the particles on the
-  /// device from its start to its end and gives the same bits as the CPU (SPH/SPHPhysics.h), except for the
-  /// Tait equation of state, whose wall-dummy density needs a pow (a few ulps; see SPHPhysics.h). The device
+  /// device from its start to its end and gives the same bits as the CPU (SPH/SPHPhysics.h). The device
   /// declines, and the CPU runs, when it cannot: a build without CUDA, no usable device, a scene with obstacles
   /// (their projection is CPU code), 2^31 particles or more, or a CUDA failure during the call (the CPU then
   /// redoes the whole call from its start). UsedBackend() says what ran the last Advance(), BackendNote() why the
