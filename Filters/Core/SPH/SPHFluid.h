@@ -205,6 +205,18 @@ public:
   std::string DeviceDeclineReason() const;
   ///@}
 
+  /// Recomputes the density, pressure and acceleration of `state` at its positions and velocities (the force
+  /// evaluation of a step, on the CPU).
+  void UpdateDerived(SPHState& state) { this->ComputeAccelerations(state); }
+
+  ///@{
+  /// What the per-particle passes use (after Setup()): the shared constants and the static wall dummies with their
+  /// grid (cell size h). For the device integrator and tests that replay its passes.
+  const SPHConstants& Constants() const { return this->Physics; }
+  const std::vector<double>& BoundaryPositions() const { return this->BoundaryPosition; }
+  const NeighborGrid& BoundaryNeighborGrid() const { return this->BoundaryGrid; }
+  ///@}
+
   /// Number of fluid neighbours (within h, itself excluded) of every particle of `state`.
   std::vector<int> NeighborCounts(const SPHState& state);
 

@@ -7,6 +7,7 @@
 #include "Common/GridCell.h"
 #include "Common/NeighborGrid.h"
 #include "SPH/SPHFluid.h"
+#include "SPH/SPHGridPasses.h"
 #include "cuda/Device.h"
 
 #include <cub/device/device_radix_sort.cuh>
@@ -83,64 +84,8 @@ struct Buffer
   }
 };
 
-/// Sorted-position range of one cell (n < 2^31).
-struct Span
-{
-  std::int32_t Begin;
-  std::int32_t End;
-};
-
-/// A cell grid as the kernels read it: NeighborGrid's geometry, the sorted coordinates, the sorted order
-/// (original index of each sorted position) and the dense cell ranges.
-struct GridView
-{
-  double Origin[3];
-  double Extent[3];
-  double Size;
-  double Inverse;
-  std::int64_t Dims[3];
-  const double* Sorted;
-  const std::int32_t* Order;
-  const Span* Cells;
-  std::int64_t Count; // points; 0: an empty grid (no query finds anything)
-};
-
-/// Calls visit(s) for the sorted positions s of the points in the cells a radius query at x may reach (NeighborGrid's
-/// reach, without its pruning of cells that hold no point within the radius), cells in (z, y, x) order, points in
-/// sorted order. The caller filters by distance.
-template <class Visit>
-__device__ void ForEachCandidate(const GridView& g, const double* x, double radius, Visit&& visit)
-{
-  if (g.Count == 0)
-  {
-    return;
-  }
-  const double rel[3] = { x[0] - g.Origin[0], x[1] - g.Origin[1], x[2] - g.Origin[2] };
-  const double margin = GridGapMargin(rel, g.Size, g.Extent);
-  std::int64_t first[3], last[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    if (!GridAxisReach(rel[a], radius, margin, g.Inverse, g.Dims[a], first + a, last + a))
-    {
-      return;
-    }
-  }
-  for (std::int64_t k = first[2]; k <= last[2]; ++k)
-  {
-    for (std::int64_t j = first[1]; j <= last[1]; ++j)
-    {
-      const Span* row = g.Cells + g.Dims[0] * (j + g.Dims[1] * k);
-      for (std::int64_t i = first[0]; i <= last[0]; ++i)
-      {
-        const Span cell = row[i];
-        for (std::int32_t s = cell.Begin; s < cell.End; ++s)
-        {
-          visit(s);
-        }
-      }
-    }
-  }
-}
+using Span = GridCellRange32;
+using GridView = GridCells;
 
 /// Bounds of the points and whether one was not finite (the grid's origin and extents).
 struct Bounds
@@ -271,86 +216,34 @@ __global__ void CellsKernel(std::int64_t n, const double* x, const std::int32_t*
   }
 }
 
-/// Density (SPHDensitySum over the fluid and the wall dummies) and the particle terms.
 __global__ void DensityKernel(std::int64_t n, GridView fluid, GridView wall, SPHConstants c, double* rho,
   double* pressure, double* pressureTerm, double* inverseDensity)
 {
   const std::int64_t s = static_cast<std::int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (s >= n)
+  if (s < n)
   {
-    return;
+    SPHGridDensity(s, fluid, wall, c, rho, pressure, pressureTerm, inverseDensity);
   }
-  const std::int64_t i = fluid.Order[s];
-  const double* xi = fluid.Sorted + 3 * s;
-  const SPHDensityConstants dc = SPHDensityConstantsOf(c);
-  SPHDensitySum sum(dc);
-  ForEachCandidate(fluid, xi, c.H, [&](std::int32_t t) {
-    if (t != s)
-    {
-      const double* xj = fluid.Sorted + 3 * static_cast<std::int64_t>(t);
-      const double dx = xi[0] - xj[0], dy = xi[1] - xj[1], dz = xi[2] - xj[2];
-      sum.Add(dx * dx + dy * dy + dz * dz, dc);
-    }
-  });
-  if (SPHNearBoundary(xi, c))
-  {
-    ForEachCandidate(wall, xi, c.H, [&](std::int32_t t) {
-      const double* xb = wall.Sorted + 3 * static_cast<std::int64_t>(t);
-      const double dx = xi[0] - xb[0], dy = xi[1] - xb[1], dz = xi[2] - xb[2];
-      sum.Add(dx * dx + dy * dy + dz * dz, dc);
-    });
-  }
-  rho[i] = sum.Density(dc);
-  SPHParticleTerms(rho[i], c, pressure + i, pressureTerm + i, inverseDensity + i);
 }
 
-/// Extrapolated pressure term of every wall dummy (SPHWallPressure over the fluid within h of it).
 __global__ void WallPressureKernel(std::int64_t nb, const double* boundaryX, GridView fluid, const double* pressure,
   const double* rho, SPHConstants c, double* wallTerm)
 {
   const std::int64_t b = static_cast<std::int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (b >= nb)
+  if (b < nb)
   {
-    return;
+    wallTerm[b] = SPHGridWallTerm(boundaryX + 3 * b, fluid, pressure, rho, c);
   }
-  const double* xb = boundaryX + 3 * b;
-  SPHWallPressure w;
-  ForEachCandidate(fluid, xb, c.H, [&](std::int32_t t) {
-    const double* xf = fluid.Sorted + 3 * static_cast<std::int64_t>(t);
-    const std::int64_t f = fluid.Order[t];
-    const double r[3] = { xb[0] - xf[0], xb[1] - xf[1], xb[2] - xf[2] };
-    const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    w.Add(r, r2, pressure[f], rho[f], c);
-  });
-  wallTerm[b] = w.Term(c);
 }
 
-/// Accelerations (SPHAcceleration: fluid neighbours, then wall dummies).
 __global__ void AccelerationKernel(std::int64_t n, GridView fluid, GridView wall, const double* v, const double* rho,
   const double* inverseDensity, const double* pressureTerm, const double* wallTerm, SPHConstants c, double* acc)
 {
   const std::int64_t s = static_cast<std::int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (s >= n)
+  if (s < n)
   {
-    return;
+    SPHGridAcceleration(s, fluid, wall, v, rho, inverseDensity, pressureTerm, wallTerm, c, acc);
   }
-  const std::int64_t i = fluid.Order[s];
-  const double* xi = fluid.Sorted + 3 * s;
-  SPHAcceleration a(xi, v + 3 * i, rho[i], inverseDensity[i], pressureTerm[i]);
-  ForEachCandidate(fluid, xi, c.H, [&](std::int32_t t) {
-    if (t != s)
-    {
-      const std::int64_t j = fluid.Order[t];
-      a.Fluid(
-        fluid.Sorted + 3 * static_cast<std::int64_t>(t), v + 3 * j, rho[j], inverseDensity[j], pressureTerm[j], c);
-    }
-  });
-  if (SPHNearBoundary(xi, c))
-  {
-    ForEachCandidate(wall, xi, c.H,
-      [&](std::int32_t t) { a.Wall(wall.Sorted + 3 * static_cast<std::int64_t>(t), wallTerm[wall.Order[t]], c); });
-  }
-  a.Finish(acc + 3 * i, c);
 }
 
 __global__ void KickDriftKernel(
