@@ -31,6 +31,15 @@
 
 vtkStandardNewMacro(vtkMeshFreeSPHFluid);
 
+namespace
+{
+/// What the field data array Backend says of the CPU, e.g. "CPU (oneTBB, 2 threads)".
+std::string CPUBackend()
+{
+  return std::string("CPU (") + meshfree::ParallelBackend() + ")";
+}
+}
+
 struct vtkMeshFreeSPHFluid::Internals
 {
   meshfree::SPHFluid Solver;
@@ -259,7 +268,8 @@ int vtkMeshFreeSPHFluid::RequestData(
   long found = 0;
   const meshfree::SPHState* cached = impl.Cache.FindAtOrBefore(step, found);
   meshfree::SPHState state = *cached;
-  const std::string backend = this->SelectBackend(static_cast<vtkIdType>(state.Size()));
+  std::string backend = this->SelectBackend(static_cast<vtkIdType>(state.Size()));
+  bool advanced = false, onDevice = false;
   const long reducedBefore = impl.Solver.ReducedSteps();
   const long last = between ? step + 1 : step; // k = step + 1 stands for the partial interval
   for (long k = found + 1; k <= last; ++k)
@@ -273,6 +283,12 @@ int vtkMeshFreeSPHFluid::RequestData(
     const bool partial = k > step;
     const meshfree::SPHFluid::Status status = impl.Solver.Advance(state, partial ? target : times[k], progress);
     this->StepsTaken += state.Steps - stepsBefore;
+    advanced = true;
+    onDevice = impl.Solver.UsedBackend() == meshfree::SPHBackend::CUDA;
+    if (this->Backend == BACKEND_CUDA && !onDevice && !impl.Solver.BackendNote().empty())
+    {
+      this->WarnBackend(impl.Solver.BackendNote());
+    }
     if (status == meshfree::SPHFluid::Status::Aborted)
     {
       vtkWarningMacro("SPH Fluid: aborted at t = " << state.Time << "; the output is empty");
@@ -287,6 +303,10 @@ int vtkMeshFreeSPHFluid::RequestData(
     {
       impl.Cache.Insert(k, state);
     }
+  }
+  if (advanced)
+  {
+    backend = onDevice ? "CUDA (" + meshfree::cuda::DeviceName() + ")" : CPUBackend();
   }
   if (impl.Solver.ReducedSteps() > reducedBefore)
   {
@@ -370,23 +390,27 @@ int vtkMeshFreeSPHFluid::RequestData(
 
 std::string vtkMeshFreeSPHFluid::SelectBackend(vtkIdType particles)
 {
-  // Only the CPU integrator exists so far (issue 15): Auto would take the device for a large job with a device
-  // present, but runs on the CPU like every other choice; CUDA says why it did not run on the device. The device is
-  // probed (once per process) only when it could be chosen.
-  std::string warning;
+  // CUDA: the device whenever it can run the setup (otherwise a warning with the reason, and the CPU). Auto: the
+  // device for jobs of at least GetAutoDeviceParticles() particles when it can run them, silently the CPU
+  // otherwise. The device is probed (once per process) only when it could be chosen.
+  meshfree::SPHFluid& solver = this->Impl->Solver;
   const bool wanted = this->Backend == BACKEND_CUDA ||
     (this->Backend == BACKEND_AUTO && particles >= vtkMeshFreeSPHFluid::GetAutoDeviceParticles());
-  if (wanted)
+  const std::string reason = wanted ? solver.DeviceDeclineReason() : std::string();
+  const bool device = wanted && reason.empty();
+  solver.SetBackend(device ? meshfree::SPHBackend::CUDA : meshfree::SPHBackend::CPU);
+  if (this->Backend == BACKEND_CUDA)
   {
-    std::string reason;
-    const bool available = meshfree::cuda::Available(&reason);
-    if (this->Backend == BACKEND_CUDA)
-    {
-      warning = available ? "SPH Fluid: Backend CUDA: this build has no device SPH integrator yet (" +
-          meshfree::cuda::DeviceName() + " unused); the CPU ran the simulation"
-                          : "SPH Fluid: Backend CUDA is not usable here (" + reason + "); the CPU ran the simulation";
-    }
+    this->WarnBackend(reason);
   }
+  return device ? "CUDA (" + meshfree::cuda::DeviceName() + ")" : CPUBackend();
+}
+
+void vtkMeshFreeSPHFluid::WarnBackend(const std::string& reason)
+{
+  const std::string warning = reason.empty()
+    ? std::string()
+    : "SPH Fluid: Backend CUDA is not usable here (" + reason + "); the CPU ran the simulation";
   if (warning != this->Impl->BackendWarning)
   {
     this->Impl->BackendWarning = warning;
@@ -395,8 +419,6 @@ std::string vtkMeshFreeSPHFluid::SelectBackend(vtkIdType particles)
       vtkWarningMacro(<< warning);
     }
   }
-  const int threads = meshfree::MaxThreads();
-  return "CPU (" + std::to_string(threads) + (threads == 1 ? " thread)" : " threads)");
 }
 
 void vtkMeshFreeSPHFluid::PrintSelf(ostream& os, vtkIndent indent)

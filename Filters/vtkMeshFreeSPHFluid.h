@@ -166,12 +166,14 @@ public:
 
   ///@{
   /**
-   * Which implementation runs the simulation: 0 Auto (default), 1 CPU, 2 CUDA. Auto would choose the CUDA
-   * device for jobs of at least GetAutoDeviceParticles() particles when the build has CUDA and a device is
-   * present (a guess until the crossover is measured on a GPU); CUDA where no device is usable gives a warning
-   * with the reason and the CPU result, never an error. The SPH integrator exists on the CPU only so far: every
-   * choice runs it, and the field data array `Backend` (one string, e.g. "CPU (2 threads)") says what ran. The
-   * results do not depend on it: changing it keeps the cached states.
+   * Which implementation runs the simulation: 0 Auto (default), 1 CPU, 2 CUDA. CUDA runs the integrator on
+   * the CUDA device (the particles stay there for each output interval; see meshfree::SPHFluid::SetBackend)
+   * whenever it can: a build with CUDA, a usable device, no obstacles; otherwise a warning with the reason and
+   * the CPU result, never an error. Auto chooses the device for jobs of at least GetAutoDeviceParticles()
+   * particles when it can run them (the threshold is a guess until the crossover is measured on a GPU), the
+   * CPU otherwise. The field data array `Backend` (one string) says what ran, e.g. "CPU (oneTBB, 2 threads)" or
+   * "CUDA (NVIDIA H200)". The results do not depend on it (bit for bit): changing it keeps the cached
+   * states.
    */
   enum BackendType
   {
@@ -235,6 +237,8 @@ protected:
 private:
   /** Applies Backend for a job of `particles` (warning when CUDA cannot run); returns what runs, for the field data. */
   std::string SelectBackend(vtkIdType particles);
+  /** Warns (once per reason) that Backend CUDA did not run on the device; an empty reason resets. */
+  void WarnBackend(const std::string& reason);
   vtkMeshFreeSPHFluid(const vtkMeshFreeSPHFluid&) = delete;
   void operator=(const vtkMeshFreeSPHFluid&) = delete;
 

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Common/NeighborGrid.h"
 
+#include "Common/GridCell.h"
+
 #include "Common/Parallel.h"
 
 #include <algorithm>
@@ -47,12 +49,7 @@ inline int BitWidth(std::uint64_t v)
 /// Cell coordinate, along one axis, of a point at `rel` from the origin, clamped into [0, dim).
 inline Index AxisCell(double rel, double inverseSize, Index dim)
 {
-  const double t = rel * inverseSize;
-  if (!(t > 0.0))
-  {
-    return 0;
-  }
-  return t >= static_cast<double>(dim - 1) ? dim - 1 : static_cast<Index>(t);
+  return GridAxisCell(rel, inverseSize, dim);
 }
 
 /// First element of chunk c when [0, n) is cut into `chunks` contiguous chunks.
@@ -455,39 +452,8 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   // coordinates go to consecutive key bits (x lowest), skipping axes that have run out of bits. This
   // orders cells exactly as the usual 3D Morton code does, with no unused key bits.
   const Index* dims = this->GridDims;
-  int axisBits[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    axisBits[a] = BitWidth(static_cast<std::uint64_t>(dims[a] - 1));
-  }
   std::vector<std::uint64_t> spread[3];
-  int keyBits = 0;
-  {
-    std::vector<std::uint64_t> levelBit[3];
-    for (int level = 0; level < 21; ++level)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        if (level < axisBits[a])
-        {
-          levelBit[a].push_back(std::uint64_t(1) << keyBits++);
-        }
-      }
-    }
-    for (int a = 0; a < 3; ++a)
-    {
-      spread[a].assign(dims[a], 0);
-      for (Index i = 1; i < dims[a]; ++i) // table[i] = table[i without its lowest bit] | that bit
-      {
-        int low = 0;
-        while (((i >> low) & 1) == 0)
-        {
-          ++low;
-        }
-        spread[a][i] = spread[a][i & (i - 1)] | levelBit[a][low];
-      }
-    }
-  }
+  const int keyBits = MortonTables(dims, spread);
   const int idxBits = BitWidth(static_cast<std::uint64_t>(n - 1));
   const bool packed = keyBits + idxBits <= 64;
   const int keyShift = packed ? idxBits : 0;
@@ -613,14 +579,55 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   return true;
 }
 
+int NeighborGrid::MortonTables(const Index dims[3], std::vector<std::uint64_t> spread[3])
+{
+  int axisBits[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    axisBits[a] = BitWidth(static_cast<std::uint64_t>(dims[a] - 1));
+  }
+  int keyBits = 0;
+  std::vector<std::uint64_t> levelBit[3];
+  for (int level = 0; level < 21; ++level)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      if (level < axisBits[a])
+      {
+        levelBit[a].push_back(std::uint64_t(1) << keyBits++);
+      }
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    spread[a].assign(dims[a], 0);
+    for (Index i = 1; i < dims[a]; ++i) // table[i] = table[i without its lowest bit] | that bit
+    {
+      int low = 0;
+      while (((i >> low) & 1) == 0)
+      {
+        ++low;
+      }
+      spread[a][i] = spread[a][i & (i - 1)] | levelBit[a][low];
+    }
+  }
+  return keyBits;
+}
+
 void NeighborGrid::ChooseGrid(double cellSize, Index validPoints)
 {
-  const double* e = this->Extent;
+  ChooseCells(this->Extent, cellSize, validPoints, this->PointsPerCell, this->Size, this->InverseSize, this->GridDims);
+}
+
+void NeighborGrid::ChooseCells(const double e[3], double cellSize, Index validPoints, double pointsPerCell,
+  double& cellEdge, double& inverseEdge, Index dims[3])
+{
+  std::fill(dims, dims + 3, Index(1));
   const double maxExtent = std::max({ e[0], e[1], e[2] });
   if (!std::isfinite(maxExtent)) // finite points whose extent overflows: one cell
   {
-    this->Size = std::numeric_limits<double>::max();
-    this->InverseSize = 0.0;
+    cellEdge = std::numeric_limits<double>::max();
+    inverseEdge = 0.0;
     return;
   }
   const double m = static_cast<double>(validPoints);
@@ -642,7 +649,7 @@ void NeighborGrid::ChooseGrid(double cellSize, Index validPoints)
       {
         logVolume += std::log(sortedExtent[a]);
       }
-      const double candidate = std::exp((logVolume + std::log(this->PointsPerCell / m)) / dim);
+      const double candidate = std::exp((logVolume + std::log(pointsPerCell / m)) / dim);
       if (candidate <= sortedExtent[dim - 1])
       {
         size = candidate;
@@ -670,12 +677,11 @@ void NeighborGrid::ChooseGrid(double cellSize, Index validPoints)
   {
     size = maxExtent > 0.0 ? maxExtent : 1.0;
   }
-  this->Size = size;
-  this->InverseSize = 1.0 / size;
+  cellEdge = size;
+  inverseEdge = 1.0 / size;
   for (int a = 0; a < 3; ++a)
   {
-    this->GridDims[a] = std::min<Index>(
-      MaxCellsPerAxis, static_cast<Index>(std::floor(e[a] * this->InverseSize)) + 1);
+    dims[a] = std::min<Index>(MaxCellsPerAxis, static_cast<Index>(std::floor(e[a] * inverseEdge)) + 1);
   }
 }
 
@@ -754,9 +760,7 @@ struct CellGaps
 
 double GapMargin(const double rel[3], double size, const double extent[3])
 {
-  const double scale = std::max({ std::fabs(rel[0]), std::fabs(rel[1]), std::fabs(rel[2]), extent[0],
-    extent[1], extent[2] });
-  return 1e-9 * size + 1e-13 * scale;
+  return GridGapMargin(rel, size, extent);
 }
 
 /// Radius of the ball holding `count` points at `density` points per unit of length^dimension.
@@ -955,15 +959,10 @@ void NeighborGrid::VisitCells(const double rel[3], const Index cq[3], double rad
   Index first[3], last[3];
   for (int a = 0; a < 3; ++a)
   {
-    const double top = static_cast<double>(this->GridDims[a] - 1);
-    const double low = std::floor((rel[a] - radius - gaps.Margin) * this->InverseSize);
-    const double high = std::floor((rel[a] + radius + gaps.Margin) * this->InverseSize);
-    if (low > top || high < 0.0)
+    if (!GridAxisReach(rel[a], radius, gaps.Margin, this->InverseSize, this->GridDims[a], first + a, last + a))
     {
       return;
     }
-    first[a] = low > 0.0 ? static_cast<Index>(low) : 0;
-    last[a] = high < top ? static_cast<Index>(high) : this->GridDims[a] - 1;
   }
   const CellRange* cells = this->CellRanges.data();
   const Index nx = this->GridDims[0], ny = this->GridDims[1];

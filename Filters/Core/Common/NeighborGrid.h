@@ -189,6 +189,19 @@ public:
   const CellRange* Cells() const { return this->CellRanges.data(); }
   ///@}
 
+  ///@{
+  /// The geometry Build() uses, for code that reproduces the grid elsewhere (the CUDA SPH integrator builds its
+  /// cell keys on the device from bounds reduced there). ChooseCells: the cell edge, its inverse and the cells per
+  /// axis for valid points whose bounds have the given extents (max - min per axis), as Build(xyz, n, cellSize)
+  /// with PointsPerCell pointsPerCell picks them. MortonTables: spread[a][c] is the key contribution of cell
+  /// coordinate c along axis a (a cell's sort key is spread[0][i] | spread[1][j] | spread[2][k]); returns the
+  /// number of key bits. A point's cell along an axis is GridAxisCell (Common/GridCell.h) of its coordinate less
+  /// the minimum of the bounds.
+  static void ChooseCells(const double extent[3], double cellSize, Index validPoints, double pointsPerCell,
+    double& cellEdge, double& inverseEdge, Index dims[3]);
+  static int MortonTables(const Index dims[3], std::vector<std::uint64_t> spread[3]);
+  ///@}
+
 private:
   int GridDimension() const; // axes with more than one cell
   bool CellCoordinate(const double x[3], double rel[3], Index cell[3]) const;

@@ -35,6 +35,26 @@ MESHFREE_HD inline double SPHDensityShape(double r2, double h, double h2, int sp
   return q * q * q;
 }
 
+/// The density sum of one particle: starts with the particle itself; Add() every neighbour (fluid particle or
+/// wall dummy, itself excluded) at squared distance r2 (ignored unless r2 < h^2), in the caller's order.
+struct SPHDensitySum
+{
+  double Sum;
+
+  MESHFREE_HD explicit SPHDensitySum(const SPHDensityConstants& c)
+    : Sum(SPHDensityShape(0.0, c.H, c.H2, c.SpikyDensity))
+  {
+  }
+  MESHFREE_HD void Add(double r2, const SPHDensityConstants& c)
+  {
+    if (r2 < c.H2)
+    {
+      this->Sum += SPHDensityShape(r2, c.H, c.H2, c.SpikyDensity);
+    }
+  }
+  MESHFREE_HD double Density(const SPHDensityConstants& c) const { return c.DensityNorm * c.Mass * this->Sum; }
+};
+
 /// Density of particle i. x: fluid positions (xyz triplets); fluidStart / fluidNeighbors: CSR neighbour rows
 /// (the particle itself not listed; entries at r >= h are skipped); boundaryX / boundaryStart /
 /// boundaryNeighbors: the same for the wall dummies (boundaryStart all zero without walls).
@@ -43,28 +63,20 @@ MESHFREE_HD inline double SPHParticleDensity(std::int64_t i, const double* x, co
   const std::int32_t* boundaryNeighbors, const SPHDensityConstants& c)
 {
   const double* xi = x + 3 * i;
-  double sum = SPHDensityShape(0.0, c.H, c.H2, c.SpikyDensity); // itself
+  SPHDensitySum sum(c);
   for (std::int64_t s = fluidStart[i]; s < fluidStart[i + 1]; ++s)
   {
     const double* xj = x + 3 * static_cast<std::int64_t>(fluidNeighbors[s]);
     const double dx = xi[0] - xj[0], dy = xi[1] - xj[1], dz = xi[2] - xj[2];
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    if (r2 < c.H2)
-    {
-      sum += SPHDensityShape(r2, c.H, c.H2, c.SpikyDensity);
-    }
+    sum.Add(dx * dx + dy * dy + dz * dz, c);
   }
   for (std::int64_t s = boundaryStart[i]; s < boundaryStart[i + 1]; ++s)
   {
     const double* xb = boundaryX + 3 * static_cast<std::int64_t>(boundaryNeighbors[s]);
     const double dx = xi[0] - xb[0], dy = xi[1] - xb[1], dz = xi[2] - xb[2];
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    if (r2 < c.H2)
-    {
-      sum += SPHDensityShape(r2, c.H, c.H2, c.SpikyDensity); // dummies weigh like fluid particles
-    }
+    sum.Add(dx * dx + dy * dy + dz * dz, c); // dummies weigh like fluid particles
   }
-  return c.DensityNorm * c.Mass * sum;
+  return sum.Density(c);
 }
 
 } // namespace meshfree

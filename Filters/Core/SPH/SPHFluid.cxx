@@ -15,7 +15,6 @@ namespace meshfree
 namespace
 {
 constexpr double StabilityLambda = 0.4;   // largest CFL factor a fixed step may use before it is reduced
-constexpr double SurfaceThreshold = 0.25; // |grad c| h above which a particle is on the surface
 constexpr Index ParallelThreshold = 4096; // below: one thread (a fork-join would cost more than the work)
 }
 
@@ -99,7 +98,6 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   {
     return;
   }
-  const SPHParameters& p = this->Params;
   this->Grid.Build(state.Position.data(), n, this->H);
   this->BuildNeighborLists(state, true);
   const double* x = state.Position.data();
@@ -107,9 +105,6 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   double* rho = state.Density.data();
   double* pressure = state.Pressure.data();
   double* acc = state.Acceleration.data();
-  const double h = this->H, h2 = this->H2, m = this->Mass;
-  const double poly6 = this->Poly6, densityNorm = this->DensityNorm, gradientNorm = this->GradientNorm;
-  const double visc = this->ViscLap;
   const double* bx = this->BoundaryPosition.data();
   const Index* fs = this->FluidStart.data();
   const Index* bs = this->BoundaryStart.data();
@@ -122,29 +117,21 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   double* inverseDensity = this->InverseDensity.data();
 
   // Density (5.32: SPH/SPHDensity.h, the function the CUDA launcher runs too) and pressure (5.40 / Tait).
-  SPHDensityConstants densityConstants;
-  densityConstants.H = h;
-  densityConstants.H2 = h2;
-  densityConstants.Mass = m;
-  densityConstants.DensityNorm = densityNorm;
-  densityConstants.SpikyDensity = this->SpikyDensity ? 1 : 0;
+  const SPHConstants& c = this->Physics;
+  const SPHDensityConstants densityConstants = SPHDensityConstantsOf(c);
   ParallelFor(
     n, 512,
     [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
         rho[i] = SPHParticleDensity(i, x, fs, fn, bx, bs, bn, densityConstants);
-        pressure[i] = this->PressureOf(rho[i]);
-        pressureTerm[i] = pressure[i] / (rho[i] * rho[i]);
-        inverseDensity[i] = 1.0 / rho[i];
+        SPHParticleTerms(rho[i], c, pressure + i, pressureTerm + i, inverseDensity + i);
       }
     },
     ParallelThreshold);
 
-  // Pressure of the dummies next to the fluid, extrapolated from their fluid neighbours with the hydrostatic
-  // increase (Adami, Hu & Adams 2012, eq. 27 for static walls): p_b = (sum_f p_f W + g . sum_f rho_f (x_b - x_f) W)
-  // / sum_f W, and their density from the equation of state.
-  const double g[3] = { p.Gravity[0], p.Gravity[1], p.Gravity[2] };
+  // Pressure of the dummies next to the fluid, extrapolated from their fluid neighbours (SPHWallPressure), and
+  // their density from the equation of state.
   const Index nb = this->BoundaryCount;
   if (nb > 0)
   {
@@ -174,145 +161,40 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
             continue;
           }
           const double* xb = bx + 3 * b;
-          this->Grid.FindWithinRadius(xb, h, ids);
-          double sumW = 0.0, sumP = 0.0, sumG = 0.0;
+          this->Grid.FindWithinRadius(xb, c.H, ids);
+          SPHWallPressure wall;
           for (Index f : ids)
           {
             const double* xf = x + 3 * f;
             const double r[3] = { xb[0] - xf[0], xb[1] - xf[1], xb[2] - xf[2] };
             const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-            if (r2 < h2)
-            {
-              const double w = this->DensityShape(r2);
-              sumW += w;
-              sumP += pressure[f] * w;
-              sumG += rho[f] * (g[0] * r[0] + g[1] * r[1] + g[2] * r[2]) * w;
-            }
+            wall.Add(r, r2, pressure[f], rho[f], c);
           }
-          const double pb = sumW > 0.0 ? std::max(0.0, (sumP + sumG) / sumW) : 0.0;
-          const double rhoB = this->DensityOf(pb);
-          pbTerm[b] = pb / (rhoB * rhoB); // the pair force's p_b / rho_b^2, once per dummy
+          pbTerm[b] = wall.Term(c); // the pair force's p_b / rho_b^2, once per dummy
         }
       },
       n >= ParallelThreshold ? 0 : nb + 1);
   }
   const double* pbTerm = this->BoundaryPressureTerm.data();
 
-  // Forces: pressure (5.37, symmetric), viscosity (5.46), colour-field surface tension, gravity.
-  const double mu = p.Viscosity, sigma = p.SurfaceTension;
-  const bool viscous = mu > 0.0, tension = sigma > 0.0;
-  const int d = p.Dimension;
-  // Monaghan's artificial viscosity: Pi_ij = -alpha c0 hs (v_ij . r_ij) / (rho_bar (r^2 + 0.01 hs^2)) for
-  // approaching pairs, hs = h / 2 the smoothing length of the support radius h.
-  const double hs = 0.5 * h;
-  const double avFactor = p.ArtificialViscosity * this->C0 * hs, avEps = 0.01 * hs * hs;
-  const bool artificial = avFactor > 0.0;
-  const double pressureFactor = m * gradientNorm, viscousFactor = mu * m * visc;
+  // Forces: pressure (5.37, symmetric), viscosity (5.46), colour-field surface tension, gravity (SPHAcceleration).
   ParallelFor(
     n, 256,
     [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
-        const double* xi = x + 3 * i;
-        const double* vi = v + 3 * i;
-        const double rhoI = rho[i], inverseI = inverseDensity[i];
-        const double termI = pressureTerm[i];
-        double ap[3] = { 0.0, 0.0, 0.0 }, av[3] = { 0.0, 0.0, 0.0 }, normal[3] = { 0.0, 0.0, 0.0 };
-        double colourLaplacian = 0.0;
-        // Colour field c = sum_j V_j W_poly6: grad W = gradient r, lap W = -6 poly6 q (d q - 4 r^2), q = h^2 - r^2.
-        auto addColour = [&](double volume, const double r[3], double r2) {
-          const double q = h2 - r2;
-          const double gradient = -6.0 * poly6 * q * q;
-          normal[0] += volume * gradient * r[0];
-          normal[1] += volume * gradient * r[1];
-          normal[2] += volume * gradient * r[2];
-          colourLaplacian += volume * -6.0 * poly6 * q * (d * q - 4.0 * r2);
-        };
+        SPHAcceleration a(x + 3 * i, v + 3 * i, rho[i], inverseDensity[i], pressureTerm[i]);
         for (Index s = fs[i]; s < fs[i + 1]; ++s)
         {
           const Index j = fn[s];
-          const double* xj = x + 3 * j;
-          const double r[3] = { xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2] };
-          const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-          if (!(r2 < h2))
-          {
-            continue;
-          }
-          const double dist = std::sqrt(r2);
-          if (dist > 0.0)
-          {
-            // -m (p_i/rho_i^2 + p_j/rho_j^2) grad W, grad W = -gradientNorm shape(r) r
-            double pair = termI + pressureTerm[j];
-            if (artificial)
-            {
-              const double* vj = v + 3 * j;
-              const double vr = (vi[0] - vj[0]) * r[0] + (vi[1] - vj[1]) * r[1] + (vi[2] - vj[2]) * r[2];
-              pair += vr < 0.0 ? -avFactor * vr / (0.5 * (rhoI + rho[j]) * (r2 + avEps)) : 0.0;
-            }
-            const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
-            ap[0] += coefficient * r[0];
-            ap[1] += coefficient * r[1];
-            ap[2] += coefficient * r[2];
-          }
-          if (viscous)
-          {
-            const double coefficient = viscousFactor * (h - dist) * inverseI * inverseDensity[j];
-            const double* vj = v + 3 * j;
-            av[0] += coefficient * (vj[0] - vi[0]);
-            av[1] += coefficient * (vj[1] - vi[1]);
-            av[2] += coefficient * (vj[2] - vi[2]);
-          }
-          if (tension)
-          {
-            addColour(m * inverseDensity[j], r, r2);
-          }
+          a.Fluid(x + 3 * j, v + 3 * j, rho[j], inverseDensity[j], pressureTerm[j], c);
         }
         for (Index s = bs[i]; s < bs[i + 1]; ++s)
         {
           const Index b = bn[s];
-          const double* xb = bx + 3 * b;
-          const double r[3] = { xi[0] - xb[0], xi[1] - xb[1], xi[2] - xb[2] };
-          const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-          if (!(r2 < h2))
-          {
-            continue;
-          }
-          const double dist = std::sqrt(r2);
-          if (dist > 0.0)
-          {
-            // Symmetric pair force with the dummy's extrapolated pressure (its density from the EOS).
-            // No artificial viscosity against the wall: with a particle sliding along it, the dummies ahead are
-            // approached and those behind are not, so the term would act as wall friction (free slip wanted).
-            const double pair = termI + pbTerm[b];
-            const double coefficient = pressureFactor * pair * this->GradientShape(r2, dist);
-            ap[0] += coefficient * r[0];
-            ap[1] += coefficient * r[1];
-            ap[2] += coefficient * r[2];
-          }
-          if (tension)
-          {
-            addColour(m / p.RestDensity, r, r2); // walls count as fluid (neutral wetting): no surface along them
-          }
+          a.Wall(bx + 3 * b, pbTerm[b], c);
         }
-        double* ai = acc + 3 * i;
-        ai[0] = ap[0] + av[0] + g[0];
-        ai[1] = ap[1] + av[1] + g[1];
-        ai[2] = ap[2] + av[2] + g[2];
-        if (tension)
-        {
-          const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-          if (length * h > SurfaceThreshold)
-          {
-            const double factor = -sigma * colourLaplacian * inverseI / length;
-            ai[0] += factor * normal[0];
-            ai[1] += factor * normal[1];
-            ai[2] += factor * normal[2];
-          }
-        }
-        if (d == 2)
-        {
-          ai[1] = 0.0;
-        }
+        a.Finish(acc + 3 * i, c);
       }
     },
     ParallelThreshold);
@@ -320,7 +202,6 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
 
 void SPHFluid::Enforce(SPHState& state, Index begin, Index end) const
 {
-  const SPHParameters& p = this->Params;
   const bool obstacles = !this->ObstaclePosition.empty();
   std::vector<Index> nearest(1);
   std::vector<double> nearestD2(1);
@@ -328,28 +209,7 @@ void SPHFluid::Enforce(SPHState& state, Index begin, Index end) const
   {
     double* x = &state.Position[3 * i];
     double* v = &state.Velocity[3 * i];
-    if (p.Walls)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        if (a == 1 && p.Dimension == 2)
-        {
-          continue;
-        }
-        const double low = p.DomainBounds[2 * a] + this->WallMargin;
-        const double high = p.DomainBounds[2 * a + 1] - this->WallMargin;
-        if (x[a] < low)
-        {
-          x[a] = low;
-          v[a] = std::max(v[a], 0.0);
-        }
-        else if (x[a] > high)
-        {
-          x[a] = high;
-          v[a] = std::min(v[a], 0.0);
-        }
-      }
-    }
+    SPHWallClamp(x, v, this->Physics);
     if (obstacles && this->NearObstacle(x) && this->ObstacleGrid.FindKNearest(x, 1, nearest, nearestD2) == 1)
     {
       const double* s = &this->ObstaclePosition[3 * nearest[0]];
@@ -405,65 +265,78 @@ void SPHFluid::Reorder(SPHState& state)
   // Density and pressure are recomputed by the next force evaluation.
 }
 
-double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
+SPHExtremes SPHFluid::Extremes(const SPHState& state) const
 {
   const Index n = state.Size();
-  struct Extremes
-  {
-    double V2 = 0.0, A2 = 0.0, Rho = 0.0;
-    bool Finite = true;
-  };
-  Extremes identity;
+  SPHExtremes identity;
   identity.Rho = this->Params.RestDensity;
-  const Extremes e = ParallelReduce(
+  return ParallelReduce(
     n, 4096, identity,
     [&](Index begin, Index end) {
-      Extremes m = identity;
+      SPHExtremes m = identity;
       for (Index i = begin; i < end; ++i)
       {
-        const double* v = &state.Velocity[3 * i];
-        const double* a = &state.Acceleration[3 * i];
-        const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        const double a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-        m.Finite = m.Finite && std::isfinite(v2) && std::isfinite(a2) && std::isfinite(state.Density[i]);
-        m.V2 = std::max(m.V2, v2);
-        m.A2 = std::max(m.A2, a2);
-        m.Rho = std::max(m.Rho, state.Density[i]);
+        m.Add(&state.Velocity[3 * i], &state.Acceleration[3 * i], state.Density[i]);
       }
       return m;
     },
-    [](Extremes x, const Extremes& y) {
-      x.V2 = std::max(x.V2, y.V2);
-      x.A2 = std::max(x.A2, y.A2);
-      x.Rho = std::max(x.Rho, y.Rho);
-      x.Finite = x.Finite && y.Finite;
+    [](SPHExtremes x, const SPHExtremes& y) {
+      x.Merge(y);
       return x;
     },
     ParallelThreshold);
-  const double v2max = e.V2, a2max = e.A2, rhoMax = e.Rho;
-  const bool finite = e.Finite;
-  if (!finite)
+}
+
+double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
+{
+  return SPHStableStep(this->Extremes(state), lambda, this->Physics);
+}
+
+bool SPHFluid::ChooseStep(const SPHExtremes& e, double time, double targetTime, long steps, double& dt, bool& last)
+{
+  const SPHParameters& p = this->Params;
+  const double remaining = targetTime - time;
+  if (p.CFLNumber > 0.0)
   {
-    return std::numeric_limits<double>::quiet_NaN();
+    dt = std::min(p.TimeStep, SPHStableStep(e, std::min(p.CFLNumber, StabilityLambda), this->Physics));
   }
-  double c = this->C0;
-  if (this->Params.EquationOfState == SPHEquationOfState::Tait)
+  else
   {
-    const double ratio = rhoMax / this->Params.RestDensity; // c^2 = dp/drho = c0^2 (rho/rho0)^6
-    c *= ratio * ratio * ratio;
+    const double stable = SPHStableStep(e, StabilityLambda, this->Physics);
+    dt = p.TimeStep;
+    if (dt > stable)
+    {
+      dt = stable;
+      ++this->ReducedStepCount;
+    }
   }
-  const double h = this->H;
-  double dt = h / (c + std::sqrt(v2max));
-  const double amax = std::sqrt(a2max);
-  if (amax > 0.0)
+  if (!(dt > 0.0) || !std::isfinite(dt))
   {
-    dt = std::min(dt, std::sqrt(h / amax));
+    std::ostringstream s;
+    s << "the simulation became unstable (non-finite velocity, acceleration or density) at t = " << time;
+    this->Error = s.str();
+    return false;
   }
-  if (this->Nu > 0.0)
+  last = false;
+  if (dt >= remaining)
   {
-    dt = std::min(dt, 0.125 * h * h / this->Nu);
+    dt = remaining;
+    last = true;
   }
-  return lambda * dt;
+  else if (dt > 0.5 * remaining)
+  {
+    dt = 0.5 * remaining; // two equal steps rather than a sliver at the end
+  }
+  if (remaining / dt > static_cast<double>(p.MaximumStepsPerInterval - steps))
+  {
+    std::ostringstream s;
+    s << "the time step collapsed to " << dt << " s at t = " << time << ": reaching t = " << targetTime
+      << " would take more than " << p.MaximumStepsPerInterval
+      << " steps (is GasStiffness or the velocity absurdly large?)";
+    this->Error = s.str();
+    return false;
+  }
+  return true;
 }
 
 SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const ProgressFunction& progress)
@@ -475,55 +348,31 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
     this->Error = "the target time lies before the state's time";
     return Status::Failed;
   }
+  this->LastBackend = SPHBackend::CPU;
+  this->DeviceNote.clear();
+  if (this->RequestedBackend == SPHBackend::CUDA)
+  {
+    bool declined = false;
+    const Status status = this->AdvanceOnDevice(state, targetTime, progress, declined);
+    if (!declined)
+    {
+      this->LastBackend = SPHBackend::CUDA;
+      return status;
+    }
+  }
   const Index n = state.Size();
   long steps = 0;
   while (state.Time < targetTime)
   {
-    const double remaining = targetTime - state.Time;
     if (n == 0)
     {
       state.Time = targetTime;
       break;
     }
     double dt;
-    if (p.CFLNumber > 0.0)
+    bool last;
+    if (!this->ChooseStep(this->Extremes(state), state.Time, targetTime, steps, dt, last))
     {
-      dt = std::min(p.TimeStep, this->StableTimeStep(state, std::min(p.CFLNumber, StabilityLambda)));
-    }
-    else
-    {
-      const double stable = this->StableTimeStep(state, StabilityLambda);
-      dt = p.TimeStep;
-      if (dt > stable)
-      {
-        dt = stable;
-        ++this->ReducedStepCount;
-      }
-    }
-    if (!(dt > 0.0) || !std::isfinite(dt))
-    {
-      std::ostringstream s;
-      s << "the simulation became unstable (non-finite velocity, acceleration or density) at t = " << state.Time;
-      this->Error = s.str();
-      return Status::Failed;
-    }
-    bool last = false;
-    if (dt >= remaining)
-    {
-      dt = remaining;
-      last = true;
-    }
-    else if (dt > 0.5 * remaining)
-    {
-      dt = 0.5 * remaining; // two equal steps rather than a sliver at the end
-    }
-    if (remaining / dt > static_cast<double>(p.MaximumStepsPerInterval - steps))
-    {
-      std::ostringstream s;
-      s << "the time step collapsed to " << dt << " s at t = " << state.Time << ": reaching t = " << targetTime
-        << " would take more than " << p.MaximumStepsPerInterval
-        << " steps (is GasStiffness or the velocity absurdly large?)";
-      this->Error = s.str();
       return Status::Failed;
     }
 
@@ -534,14 +383,7 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
       [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
-          double* x = &state.Position[3 * i];
-          double* v = &state.Velocity[3 * i];
-          const double* a = &state.Acceleration[3 * i];
-          for (int c = 0; c < 3; ++c)
-          {
-            v[c] += half * a[c];
-            x[c] += dt * v[c];
-          }
+          SPHKickDrift(&state.Position[3 * i], &state.Velocity[3 * i], &state.Acceleration[3 * i], half, dt);
         }
         this->Enforce(state, begin, end);
       },
@@ -557,7 +399,7 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
       [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
-          state.Velocity[i] += half * state.Acceleration[i];
+          SPHKick(&state.Velocity[i], &state.Acceleration[i], half);
         }
       },
       ParallelThreshold);

@@ -66,20 +66,38 @@
 // particles of a cell; rows identical to per-particle queries), then every pass streams through the lists. Every ReorderInterval steps the particle arrays are permuted into
 // the grid's Z-order so that neighbours are close in memory. Everything the future depends on is in SPHState, so
 // a state restored from a cache continues bit-identically, whatever the number of threads.
+//
+// Back ends (SetBackend): the per-particle arithmetic is shared MESHFREE_HD code (SPH/SPHPhysics.h,
+// SPH/SPHDensity.h); the CPU loops (SPHFluid.cxx) feed it CSR neighbour rows, the CUDA integrator
+// (cuda/SPHDevice.h, driven by SPHFluidDevice.cxx) the same neighbours in the same order from a grid rebuilt on the
+// device, so both give the same bits.
 #ifndef meshfree_SPHFluid_h
 #define meshfree_SPHFluid_h
 
 #include "Common/NeighborGrid.h"
 #include "SPH/SPHDensity.h"
+#include "SPH/SPHPhysics.h"
 
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace meshfree
 {
+namespace cuda
+{
+class SPHDevice;
+}
+
+/// Which implementation runs Advance().
+enum class SPHBackend
+{
+  CPU = 0, ///< the oneTBB loops of SPHFluid.cxx
+  CUDA = 1 ///< the CUDA device (cuda/SPHDevice.h), where usable; otherwise the CPU (see BackendNote())
+};
 
 enum class SPHEquationOfState
 {
@@ -171,6 +189,34 @@ public:
   /// Advances `state` to exactly `targetTime` (>= state.Time).
   Status Advance(SPHState& state, double targetTime, const ProgressFunction& progress = nullptr);
 
+  ///@{
+  /// The implementation Advance() asks for (default CPU). With CUDA, Advance() keeps the particles on the
+  /// device from its start to its end and gives the same bits as the CPU (SPH/SPHPhysics.h). The device
+  /// declines, and the CPU runs, when it cannot: a build without CUDA, no usable device, a scene with obstacles
+  /// (their projection is CPU code), 2^31 particles or more, or a CUDA failure during the call (the CPU then
+  /// redoes the whole call from its start). UsedBackend() says what ran the last Advance(), BackendNote() why the
+  /// device declined it (empty when it ran or was not asked for).
+  void SetBackend(SPHBackend backend) { this->RequestedBackend = backend; }
+  SPHBackend Backend() const { return this->RequestedBackend; }
+  SPHBackend UsedBackend() const { return this->LastBackend; }
+  const std::string& BackendNote() const { return this->DeviceNote; }
+  /// Why the device cannot run this setup (after Setup()), or empty when it can (a device is present, no
+  /// obstacles). Probes the CUDA runtime once per process.
+  std::string DeviceDeclineReason() const;
+  ///@}
+
+  /// Recomputes the density, pressure and acceleration of `state` at its positions and velocities (the force
+  /// evaluation of a step, on the CPU).
+  void UpdateDerived(SPHState& state) { this->ComputeAccelerations(state); }
+
+  ///@{
+  /// What the per-particle passes use (after Setup()): the shared constants and the static wall dummies with their
+  /// grid (cell size h). For the device integrator and tests that replay its passes.
+  const SPHConstants& Constants() const { return this->Physics; }
+  const std::vector<double>& BoundaryPositions() const { return this->BoundaryPosition; }
+  const NeighborGrid& BoundaryNeighborGrid() const { return this->BoundaryGrid; }
+  ///@}
+
   /// Number of fluid neighbours (within h, itself excluded) of every particle of `state`.
   std::vector<int> NeighborCounts(const SPHState& state);
 
@@ -199,14 +245,20 @@ public:
   double StableTimeStep(const SPHState& state, double lambda) const;
 
 private:
+  /// The step of the state whose CFL maxima are `e` at `time` towards `targetTime`, `steps` already taken in
+  /// this call (TimeStep, CFL, the stability reduction, the landing on targetTime); false with Error set when the
+  /// step collapsed or the state is unstable.
+  bool ChooseStep(const SPHExtremes& e, double time, double targetTime, long steps, double& dt, bool& last);
+  SPHExtremes Extremes(const SPHState& state) const;
+  /// Advance() on the device (SPHFluidDevice.cxx); declined = true (state untouched) when the CPU must run it.
+  Status AdvanceOnDevice(SPHState& state, double targetTime, const ProgressFunction& progress, bool& declined);
   void ComputeAccelerations(SPHState& state);
   void BuildNeighborLists(const SPHState& state, bool withBoundary);
   void Reorder(SPHState& state);
   void Enforce(SPHState& state, Index begin, Index end) const;
   bool NearBoundary(const double* x) const;
   bool NearObstacle(const double* x) const;
-  double PressureOf(double density) const;
-  double DensityOf(double pressure) const; // inverse of the equation of state for p >= 0
+  void FillConstants(); // Physics from the members below, at the end of Setup()
 
   SPHParameters Params;
   std::vector<std::string> WarningList;
@@ -220,12 +272,7 @@ private:
   double DensityShape(double r2) const { return SPHDensityShape(r2, this->H, this->H2, this->SpikyDensity ? 1 : 0); }
   double GradientShape(double r2, double r) const
   {
-    if (this->SpikyGradient)
-    {
-      return (this->H - r) * (this->H - r) / r;
-    }
-    const double q = this->H2 - r2;
-    return q * q;
+    return SPHGradientShape(r2, r, this->H, this->H2, this->SpikyGradient ? 1 : 0);
   }
   bool SpikyDensity = false, SpikyGradient = false;
   double DensityNorm = 0.0, DensityCorrection = 1.0, CompressionResponse = 1.0;
@@ -233,6 +280,7 @@ private:
   double Poly6 = 0.0;                         // colour field, lattice-normalised
   double ViscLap = 0.0, ViscCorrection = 1.0; // lap W = ViscLap (h - r)
   double WallMargin = 0.0;
+  SPHConstants Physics; // the above as the shared per-particle functions (SPH/SPHPhysics.h) take them
 
   // Boundary (dummy) particles, static; obstacle surface samples with outward normals; their grids.
   std::vector<double> BoundaryPosition;
@@ -243,6 +291,13 @@ private:
   std::vector<double> ObstaclePosition, ObstacleNormal;
   NeighborGrid ObstacleGrid;
   double ObstacleBox[6] = { 0, -1, 0, -1, 0, -1 };
+
+  // Back end: asked for, used by the last Advance(), why the device declined; the device state (shared_ptr:
+  // a copy of the solver shares it, and re-uploads its own state on every Advance()).
+  SPHBackend RequestedBackend = SPHBackend::CPU;
+  SPHBackend LastBackend = SPHBackend::CPU;
+  std::string DeviceNote;
+  std::shared_ptr<cuda::SPHDevice> Device;
 
   // Per-step scratch.
   NeighborGrid Grid;

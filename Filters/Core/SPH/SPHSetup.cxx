@@ -346,54 +346,59 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
   }
   this->BoundaryCount = static_cast<Index>(this->BoundaryPosition.size() / 3);
   this->BoundaryGrid.Build(this->BoundaryPosition.data(), this->BoundaryCount, h);
+  this->FillConstants();
 }
 
-double SPHFluid::PressureOf(double rho) const
+void SPHFluid::FillConstants()
 {
-  const double rho0 = this->Params.RestDensity;
-  double pressure;
-  if (this->Params.EquationOfState == SPHEquationOfState::Tait)
+  const SPHParameters& p = this->Params;
+  SPHConstants& c = this->Physics;
+  c = SPHConstants();
+  c.Dimension = p.Dimension;
+  c.Tait = p.EquationOfState == SPHEquationOfState::Tait ? 1 : 0;
+  c.SpikyDensity = this->SpikyDensity ? 1 : 0;
+  c.SpikyGradient = this->SpikyGradient ? 1 : 0;
+  c.Walls = p.Walls ? 1 : 0;
+  c.H = this->H;
+  c.H2 = this->H2;
+  c.Mass = this->Mass;
+  c.RestDensity = p.RestDensity;
+  c.K = this->K;
+  c.C0 = this->C0;
+  c.TaitB = this->TaitB;
+  c.Nu = this->Nu;
+  c.DensityNorm = this->DensityNorm;
+  c.GradientNorm = this->GradientNorm;
+  c.Poly6 = this->Poly6;
+  c.ViscLap = this->ViscLap;
+  c.SurfaceTension = p.SurfaceTension;
+  c.Viscous = p.Viscosity > 0.0 ? 1 : 0;
+  c.Tension = p.SurfaceTension > 0.0 ? 1 : 0;
+  c.PressureFactor = this->Mass * this->GradientNorm;
+  c.ViscousFactor = p.Viscosity * this->Mass * this->ViscLap;
+  // Monaghan's artificial viscosity: Pi_ij = -alpha c0 hs (v_ij . r_ij) / (rho_bar (r^2 + 0.01 hs^2)) for
+  // approaching pairs, hs = h / 2 the smoothing length of the support radius h.
+  const double hs = 0.5 * this->H;
+  c.ArtificialFactor = p.ArtificialViscosity * this->C0 * hs;
+  c.ArtificialEpsilon = 0.01 * hs * hs;
+  c.Artificial = c.ArtificialFactor > 0.0 ? 1 : 0;
+  c.SurfaceThreshold = 0.25;
+  for (int a = 0; a < 3; ++a)
   {
-    const double ratio = rho / rho0;
-    const double r2 = ratio * ratio;
-    pressure = this->TaitB * (r2 * r2 * r2 * ratio - 1.0);
+    c.Gravity[a] = p.Gravity[a];
   }
-  else
+  for (int a = 0; a < 6; ++a)
   {
-    pressure = this->K * (rho - rho0);
+    c.DomainBounds[a] = p.DomainBounds[a];
+    c.ObstacleBox[a] = this->ObstacleBox[a];
   }
-  return pressure > 0.0 ? pressure : 0.0; // clamped: see the header
-}
-
-double SPHFluid::DensityOf(double pressure) const
-{
-  const double rho0 = this->Params.RestDensity;
-  if (this->Params.EquationOfState == SPHEquationOfState::Tait)
-  {
-    return rho0 * std::pow(1.0 + pressure / this->TaitB, 1.0 / 7.0);
-  }
-  return rho0 + pressure / this->K;
+  c.WallMargin = this->WallMargin;
+  this->Device.reset(); // the device copy of the constants and dummies is made again on the next device run
 }
 
 bool SPHFluid::NearBoundary(const double* x) const
 {
-  const SPHParameters& p = this->Params;
-  const double h = this->H;
-  if (p.Walls)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      if (a == 1 && p.Dimension == 2)
-      {
-        continue;
-      }
-      if (x[a] - p.DomainBounds[2 * a] < h || p.DomainBounds[2 * a + 1] - x[a] < h)
-      {
-        return true;
-      }
-    }
-  }
-  return this->NearObstacle(x);
+  return SPHNearBoundary(x, this->Physics);
 }
 
 bool SPHFluid::NearObstacle(const double* x) const

@@ -1,8 +1,11 @@
 // Without a usable CUDA device (or in a build without CUDA): Available() is false with a reason, the same reason
 // on every call and from every thread (probed once), DeviceName() is empty and the launcher declines with that
-// reason. Exit 77 (skipped) where a device is usable.
+// reason; the SPH fluid asked for the CUDA back end runs on the CPU, says why, and gives the CPU's states bit for
+// bit. Exit 77 (skipped) where a device is usable.
+#include "Cuda/SPHBackendSupport.h"
 #include "cuda/Device.h"
 #include "cuda/SPHDensity.h"
+#include "cuda/SPHDevice.h"
 
 #include <cstdio>
 #include <string>
@@ -67,5 +70,32 @@ int main()
     "the launcher declines");
   Check(error == reason, "the launcher gives the same reason");
   Check(rho == -1.0, "the launcher leaves the output alone");
+
+  // The SPH integrator: the device object declines with the reason; SPHFluid with Backend CUDA runs the CPU.
+  meshfree::cuda::SPHDevice device;
+  meshfree::NeighborGrid empty;
+  error.clear();
+  Check(!device.Setup(meshfree::SPHConstants(), nullptr, 0, empty, &error) && error == reason,
+    "the device integrator declines with the reason");
+  for (int dimension : { 2, 3 })
+  {
+    const meshfree::SPHParameters p = sphtest::DamBreak(dimension, dimension == 2 ? 0.005 : 0.01, false, 0.0);
+    meshfree::SPHFluid cpu, fallback;
+    cpu.Setup(p);
+    fallback.Setup(p);
+    fallback.SetBackend(meshfree::SPHBackend::CUDA);
+    Check(fallback.DeviceDeclineReason() == reason, "SPHFluid::DeviceDeclineReason() is the reason");
+    meshfree::SPHState a = cpu.InitialState(), b = fallback.InitialState();
+    for (double t : { 0.01, 0.02 })
+    {
+      Check(cpu.Advance(a, t) == meshfree::SPHFluid::Status::Ok, "CPU advance");
+      Check(fallback.Advance(b, t) == meshfree::SPHFluid::Status::Ok, "Backend CUDA advance");
+      Check(fallback.UsedBackend() == meshfree::SPHBackend::CPU, "Backend CUDA ran on the CPU");
+      Check(fallback.BackendNote() == reason, "BackendNote() says why");
+      Check(cpu.UsedBackend() == meshfree::SPHBackend::CPU && cpu.BackendNote().empty(), "Backend CPU: no note");
+      Check(sphtest::SameState(a, b, "fallback"), "Backend CUDA gives the CPU's state bit for bit");
+    }
+    Check(a.Steps > 20, "the runs took steps");
+  }
   return failures == 0 ? 0 : 1;
 }
