@@ -260,7 +260,7 @@ bool MLSShapeFunctions(const double* xi, const double* w, const double* dw, int 
     mls::EvaluateBasis<D, M>(xi + 3 * j, p);
     mls::AccumulateMoment<Q>(p, w[j], moment);
   }
-  constexpr int R = mls::MLSColumns<D, M>();
+  constexpr int R = mls::MLSColumns<D, M>::Value;
   const int r = gradient ? R : 1;
   double y[Q * R];
   if (!SolveMomentIdentity<Q, R>(moment, r, exactCondition, y, condition))

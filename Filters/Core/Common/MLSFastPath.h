@@ -40,10 +40,17 @@ struct BasisEntry
   static constexpr int Variable = MakeBasisTable(D, M).Variable[I];
 };
 
+/// BasisSize(D, M) as a compile-time scalar (device code may not call the host constexpr function).
+template <int D, int M>
+struct BasisSizeOf
+{
+  static constexpr int Value = BasisSize(D, M);
+};
+
 template <int D, int M, int I = 1>
 MESHFREE_HD inline void FillBasis(const double* xi, double* p)
 {
-  if constexpr (I < BasisSize(D, M))
+  if constexpr (I < BasisSizeOf<D, M>::Value)
   {
     p[I] = p[BasisEntry<D, M, I>::Parent] * xi[BasisEntry<D, M, I>::Variable];
     FillBasis<D, M, I + 1>(xi, p);
@@ -207,10 +214,10 @@ MESHFREE_HD inline double ShapeDot(const double* p, const double* y)
 
 /// Right-hand sides of the MLS solve: 1 (values) or, with gradients and degree >= 1, 1 + D (e_1 .. e_{1+D}).
 template <int D, int M>
-constexpr int MLSColumns()
+struct MLSColumns
 {
-  return M > 0 ? D + 1 : 1;
-}
+  static constexpr int Value = M > 0 ? D + 1 : 1;
+};
 
 } // namespace mls
 } // namespace meshfree
