@@ -20,6 +20,7 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
 #include "vtkStructuredGrid.h"
 
 #include "Approximation/Approximation.h"
@@ -514,6 +515,7 @@ int vtkMeshlessApproximation::RequestData(
   opts.ComputeGradients = this->ComputeGradients;
   opts.Diagnostics = this->Diagnostics;
   opts.NullValue = this->NullValue;
+  opts.Backend = static_cast<meshfree::ApproximationBackend>(this->Backend);
   if (!std::isfinite(this->NullValue))
   {
     vtkWarningMacro("NullValue " << this->NullValue << " is not a finite number: masked points get 0 instead.");
@@ -716,8 +718,37 @@ int vtkMeshlessApproximation::RequestData(
   out.Valid = validOut.data();
   out.NeighborCounts = this->Diagnostics ? countValues.data() : nullptr;
   out.Conditions = this->Diagnostics ? conditionValues.data() : nullptr;
-  const bool done = approx.Evaluate(eval.data(), m, out, vtkMeshFreeFilterSupport::Progress(this));
+  // An image output whose points are origin + index x spacing bit for bit (extent from 0): the evaluation generates
+  // them itself (the device MLS on the device, no upload of the points); the results are those at eval.
+  meshfree::ImageGeometry lattice;
+  bool generated = false;
+  vtkImageData* image = vtkImageData::SafeDownCast(output);
+  if (image && !this->HeightField && m > 0)
+  {
+    int ext[6];
+    image->GetExtent(ext);
+    image->GetOrigin(lattice.Origin);
+    image->GetSpacing(lattice.Spacing);
+    generated = ext[0] == 0 && ext[2] == 0 && ext[4] == 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      lattice.Dimensions[a] = ext[2 * a + 1] - ext[2 * a] + 1;
+    }
+    generated = generated && lattice.NumberOfPoints() == static_cast<meshfree::Index>(m);
+    for (vtkIdType i = 0; generated && i < m; ++i)
+    {
+      double x[3];
+      meshfree::ImagePoint(lattice, i, x);
+      generated = std::memcmp(x, &eval[3 * i], sizeof(x)) == 0;
+    }
+  }
+  const bool done = generated ? approx.EvaluateImage(lattice, out, vtkMeshFreeFilterSupport::Progress(this))
+                              : approx.Evaluate(eval.data(), m, out, vtkMeshFreeFilterSupport::Progress(this));
   const meshfree::ApproximationReport& report = approx.Report();
+  if (this->Backend == BACKEND_CUDA && !report.BackendNote.empty())
+  {
+    vtkWarningMacro(<< report.BackendNote);
+  }
   if (!done && !report.Aborted && valid > 0)
   {
     vtkWarningMacro("Approximation failed (" << approx.Error()
@@ -834,6 +865,10 @@ int vtkMeshlessApproximation::RequestData(
   {
     outPD->SetActiveScalars(selected.front().Name.c_str());
   }
+  vtkNew<vtkStringArray> ran;
+  ran->SetName("Backend");
+  ran->InsertNextValue(report.Backend);
+  output->GetFieldData()->AddArray(ran);
   if (controller)
   {
     // How many points of other ranks this rank received (field data `HaloPoints`, distributed runs only).
@@ -858,6 +893,7 @@ void vtkMeshlessApproximation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "HeightField: " << this->HeightField << "\n";
   os << indent << "ShepardNormalization: " << this->ShepardNormalization << "\n";
   os << indent << "NullValue: " << this->NullValue << "\n";
+  os << indent << "Backend: " << this->Backend << "\n";
   os << indent << "ModelBounds: " << this->ModelBounds[0] << ", " << this->ModelBounds[1] << ", "
      << this->ModelBounds[2] << ", " << this->ModelBounds[3] << ", " << this->ModelBounds[4] << ", "
      << this->ModelBounds[5] << "\n";

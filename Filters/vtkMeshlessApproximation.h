@@ -140,6 +140,28 @@ public:
   ///@}
 
   ///@{
+  /**
+   * Which implementation evaluates: 0 Auto (default), 1 CPU, 2 CUDA. Only MLS has a device path: k nearest
+   * (SupportRadius 0), a cloud of intrinsic dimension 2 or 3, BasisDegree 1-2 (3 in 2D), a weight without exp
+   * (Wendland, Poly6, W3-W5, Lucy, Spiky, CubicSpline) and Diagnostics off; the device finishes the points whose
+   * fast path succeeds (the CPU's bits: same neighbours, same arithmetic) and the CPU the others with its robust
+   * chain. Everything else runs on the CPU whatever the choice. Auto takes the device only when MeshFree was
+   * built with CUDA, a device is usable and the job reaches 10^6 (output points x neighbours per fit), a guess
+   * until measured on a GPU. CUDA where the device cannot run gives a warning with the reason and the CPU
+   * result, never an error. The output's field data array `Backend` (one string) says what ran: "CPU (oneTBB, 2
+   * threads)" or "CUDA (NVIDIA H200)". Distributed, every rank chooses for its own part (device per rank).
+   */
+  enum BackendType
+  {
+    BACKEND_AUTO = 0,
+    BACKEND_CPU = 1,
+    BACKEND_CUDA = 2
+  };
+  vtkSetClampMacro(Backend, int, BACKEND_AUTO, BACKEND_CUDA);
+  vtkGetMacro(Backend, int);
+  ///@}
+
+  ///@{
   /// Output grid without a probe: bounds (default all 0 = the input's bounds) and samples per axis.
   vtkSetVector6Macro(ModelBounds, double);
   vtkGetVector6Macro(ModelBounds, double);
@@ -187,6 +209,7 @@ protected:
   bool HeightField = false;
   bool ShepardNormalization = true;
   double NullValue = 0.0;
+  int Backend = BACKEND_AUTO;
   double ModelBounds[6] = { 0, 0, 0, 0, 0, 0 };
   int SampleDimensions[3] = { 101, 101, 101 };
   std::vector<std::string> PointArrays;

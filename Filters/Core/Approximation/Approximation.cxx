@@ -3,6 +3,7 @@
 // MLS. PU-WLS is in ApproximationPU.cxx, SPH in ApproximationSPH.cxx.
 #include "Approximation/Approximation.h"
 #include "Approximation/ApproximationPU.h"
+#include "cuda/ApproximationDevice.h"
 
 #include <algorithm>
 #include <cctype>
@@ -98,6 +99,7 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
   this->Rep = ApproximationReport();
   this->Err.clear();
   this->PU.reset();
+  this->DeviceUploaded = false;
   this->GlobalDegree = -1;
   n = std::max<Index>(n, 0);
   components = std::max(components, 0);

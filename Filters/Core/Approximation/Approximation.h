@@ -43,6 +43,7 @@
 #ifndef meshfree_Approximation_h
 #define meshfree_Approximation_h
 
+#include "Common/ImageProbes.h"
 #include "Common/Kernels.h"
 #include "Common/LocalFit.h"
 #include "Common/NeighborGrid.h"
@@ -55,6 +56,10 @@
 
 namespace meshfree
 {
+namespace cuda
+{
+class MLSDevice;
+}
 
 enum class ApproximationMethod
 {
@@ -68,6 +73,23 @@ enum class ApproximationMethod
 /// "LS", "WLS", "MLS", "PU-WLS", "SPH".
 const char* ApproximationMethodName(ApproximationMethod method);
 bool ApproximationMethodFromName(const std::string& name, ApproximationMethod& out);
+
+/// Which implementation evaluates. Only MLS has a device path (cuda/ApproximationDevice.h): k-nearest support,
+/// intrinsic dimension 2 or 3, degree 1-2 (3 in 2D), a plain-arithmetic weight, no exact condition numbers
+/// (Diagnostics); everything else runs on the CPU whatever the choice. CUDA where the device cannot run gives
+/// the CPU result and says why (ApproximationReport::BackendNote), never an error. Auto takes the device only
+/// when the build has CUDA, a device is usable and the job is large (kAutoDeviceWork).
+enum class ApproximationBackend
+{
+  Auto = 0,
+  CPU = 1,
+  CUDA = 2
+};
+
+/// Auto uses the device from this many (evaluation points x neighbours per fit) on: a guess (the first CUDA
+/// call creates a context, tenths of a second; 10^6 such terms take about that long on 2 CPU cores) until
+/// measured on a GPU.
+constexpr double kAutoDeviceWork = 1e6;
 
 struct ApproximationOptions
 {
@@ -84,6 +106,7 @@ struct ApproximationOptions
   bool ComputeGradients = false;
   bool Diagnostics = false;
   double NullValue = 0.0;
+  ApproximationBackend Backend = ApproximationBackend::Auto;
 };
 
 /// Where the results go (m evaluation points, C components). Null pointers switch outputs off.
@@ -140,6 +163,11 @@ struct ApproximationReport
   Index Centers = 0;         // PU-WLS centres kept
   int DegreeUsed = 0;        // LS/WLS: degree of the global fit
   bool Aborted = false;
+  std::string Backend;              // what evaluated: "CPU (oneTBB, 2 threads)" or "CUDA (NVIDIA H200)"
+  std::string BackendNote;          // why the CPU ran where the device was asked for (or, Auto, could have run)
+  Index DeviceEvaluated = 0;        // points finished on the device
+  Index DeviceToCPU = 0;            // points the device handed to the CPU (robust path, fallbacks, far queries)
+  double DeviceKernelSeconds = 0.0; // time in the device kernels (CUDA events)
 };
 
 
@@ -172,6 +200,10 @@ public:
   /// every output is defined in any case (masked points get NullValue and Valid = 0).
   bool Evaluate(const double* xyz, Index m, const ApproximationOutput& out,
     const ProgressCallback& progress = ProgressCallback());
+  /// The same at the points of an image (ImagePoint order, x fastest), generated where they are used (on the
+  /// device for the device MLS) instead of stored.
+  bool EvaluateImage(
+    const ImageGeometry& image, const ApproximationOutput& out, const ProgressCallback& progress = ProgressCallback());
 
   const ApproximationReport& Report() const { return this->Rep; }
   const std::string& Error() const { return this->Err; }
@@ -205,6 +237,20 @@ private:
     bool Lowered;
   };
 
+  /// Evaluate()/EvaluateImage(): m points from xyz, or from image when xyz is null.
+  bool EvaluateAt(const double* xyz, const ImageGeometry* image, Index m, const ApproximationOutput& out,
+    const ProgressCallback& progress);
+  enum class DeviceRun
+  {
+    NotUsed,
+    Ran,
+    Aborted
+  };
+  /// Applies Options.Backend to an MLS evaluation (see ApproximationBackend): runs the device path when chosen
+  /// and possible, fills the outputs of the points it finished and lists the others (ascending) in cpuPoints.
+  /// Sets Report().Backend and BackendNote.
+  DeviceRun MLSOnDevice(const double* xyz, const ImageGeometry* image, Index m, const ApproximationOutput& out,
+    const ProgressCallback& progress, std::vector<Index>& cpuPoints);
   bool PrepareGlobalFit();
   bool PreparePU(const double* xyz, Index m);
   /// The PU-WLS lattice's origin: the centre of the cloud's bounds.
@@ -267,6 +313,9 @@ private:
   int GlobalNeighbors = 0;
   double GlobalCondition = 0.0;
   std::unique_ptr<PUData> PU;
+  std::unique_ptr<cuda::MLSDevice> Device; // the cloud on the CUDA device (uploaded on first use)
+  bool DeviceUploaded = false;
+  std::vector<double> DeviceKey; // the options the device copy was uploaded with
   // A distributed cloud (SetCloud with a partition): the combine functions, the global valid count, the LS
   // moment sums per degree, the PU-WLS box and the largest given SPH volume, all over every part.
   bool Partitioned = false;

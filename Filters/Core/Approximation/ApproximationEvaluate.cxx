@@ -220,22 +220,54 @@ Approximator::PointResult Approximator::GlobalPoint(const double x[3], const App
 bool Approximator::Evaluate(
   const double* xyz, Index m, const ApproximationOutput& out, const ProgressCallback& progress)
 {
+  return this->EvaluateAt(xyz, nullptr, m, out, progress);
+}
+
+bool Approximator::EvaluateImage(
+  const ImageGeometry& image, const ApproximationOutput& out, const ProgressCallback& progress)
+{
+  const Index m = std::max<Index>(image.NumberOfPoints(), 0);
+  if (this->Opts.Method != ApproximationMethod::PUWLS)
+  {
+    return this->EvaluateAt(nullptr, &image, m, out, progress);
+  }
+  // PU-WLS places its centres from the evaluation points: it gets them stored.
+  std::vector<double> xyz(3 * static_cast<size_t>(m));
+  for (Index i = 0; i < m; ++i)
+  {
+    ImagePoint(image, i, &xyz[3 * i]);
+  }
+  return this->EvaluateAt(xyz.data(), nullptr, m, out, progress);
+}
+
+bool Approximator::EvaluateAt(const double* xyz, const ImageGeometry* image, Index m, const ApproximationOutput& out,
+  const ProgressCallback& progress)
+{
   this->Rep.Evaluated = std::max<Index>(m, 0);
   this->Rep.Masked = this->Rep.Widened = this->Rep.DegreeLowered = 0;
   this->Rep.Aborted = false;
   this->Rep.Centers = 0;
   this->Rep.DegreeUsed = -1;
+  this->Rep.DeviceEvaluated = this->Rep.DeviceToCPU = 0;
+  this->Rep.DeviceKernelSeconds = 0.0;
+  this->Rep.Backend = std::string("CPU (") + ParallelBackend() + ")";
+  this->Rep.BackendNote.clear();
   this->Err.clear();
   if (m <= 0)
   {
     return true;
   }
+  // The points the CPU loop evaluates: all (cpuPoints unused), or those the device left (cpuPoints).
+  std::vector<Index> cpuPoints;
+  bool listed = false;
+  auto pointAt = [&](Index t) { return listed ? cpuPoints[static_cast<size_t>(t)] : t; };
+  Index count = m;
   auto maskFrom = [&](Index begin) {
-    for (Index i = begin; i < m; ++i)
+    for (Index t = begin; t < count; ++t)
     {
-      this->Mask(out, i);
+      this->Mask(out, pointAt(t));
     }
-    this->Rep.Masked += m - begin;
+    this->Rep.Masked += count - begin;
   };
   if (!this->PrepareShapeFunctions())
   {
@@ -254,7 +286,7 @@ bool Approximator::Evaluate(
       ready = this->PrepareGlobalFit();
       break;
     case ApproximationMethod::PUWLS:
-      ready = this->PreparePU(xyz, m);
+      ready = this->PreparePU(xyz, m); // xyz is set (EvaluateImage)
       break;
     case ApproximationMethod::SPH:
       ready = this->PrepareSPHVolumes();
@@ -271,6 +303,28 @@ bool Approximator::Evaluate(
     maskFrom(0);
     return false;
   }
+  if (this->Opts.Method != ApproximationMethod::MLS && this->Opts.Backend == ApproximationBackend::CUDA)
+  {
+    this->Rep.BackendNote = std::string("Backend CUDA: the CPU evaluated (only MLS has a device path, not ") +
+      ApproximationMethodName(this->Opts.Method) + ")";
+  }
+  if (this->Opts.Method == ApproximationMethod::MLS)
+  {
+    switch (this->MLSOnDevice(xyz, image, m, out, progress, cpuPoints))
+    {
+      case DeviceRun::NotUsed:
+        break;
+      case DeviceRun::Ran:
+        listed = true;
+        count = static_cast<Index>(cpuPoints.size());
+        break;
+      case DeviceRun::Aborted:
+        this->Rep.Aborted = true;
+        maskFrom(0);
+        this->Err = "aborted";
+        return false;
+    }
+  }
   std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
   struct Counts
   {
@@ -280,9 +334,9 @@ bool Approximator::Evaluate(
   };
   const Index blockSize = 16384;
   Index masked = 0, widened = 0, lowered = 0;
-  for (Index begin = 0; begin < m; begin += blockSize)
+  for (Index begin = 0; begin < count; begin += blockSize)
   {
-    if (progress && !progress(static_cast<double>(begin) / static_cast<double>(m)))
+    if (progress && !progress(static_cast<double>(begin) / static_cast<double>(count)))
     {
       this->Rep.Aborted = true;
       maskFrom(begin);
@@ -292,7 +346,7 @@ bool Approximator::Evaluate(
       this->Err = "aborted";
       return false;
     }
-    const Index end = std::min(m, begin + blockSize);
+    const Index end = std::min(count, begin + blockSize);
     // A global fit is cheap to evaluate: threads would cost more than they save on small blocks.
     const bool global =
       this->Opts.Method == ApproximationMethod::LS || this->Opts.Method == ApproximationMethod::WLS;
@@ -303,9 +357,19 @@ bool Approximator::Evaluate(
         // neighbours in another order, so a block's sums must not depend on which thread ran which block before.
         s.RadiusGuess = 0.0;
         Counts mine;
-        for (Index i = begin + b0; i < begin + b1; ++i)
+        for (Index t = begin + b0; t < begin + b1; ++t)
         {
-          const double* x = xyz + 3 * i;
+          const Index i = pointAt(t);
+          double probe[3];
+          const double* x = probe;
+          if (xyz)
+          {
+            x = xyz + 3 * i;
+          }
+          else
+          {
+            ImagePoint(*image, i, probe);
+          }
           PointResult r{ false, 0, 0.0, false, false };
           if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
           {

@@ -11,4 +11,15 @@
 #define MESHFREE_HD
 #endif
 
+// MESHFREE_UNROLL before a loop with compile-time bounds: fully unrolled, so that register arrays are indexed by
+// constants only (a run-time index puts the array on the stack in device code). A bare "#pragma unroll" trips
+// g++'s -Wunknown-pragmas, hence the two spellings.
+#ifndef MESHFREE_UNROLL
+#ifdef __CUDACC__
+#define MESHFREE_UNROLL _Pragma("unroll")
+#else
+#define MESHFREE_UNROLL _Pragma("GCC unroll 32")
+#endif
+#endif
+
 #endif

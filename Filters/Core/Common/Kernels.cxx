@@ -291,3 +291,14 @@ double Kernel::Laplacian(double r) const
 }
 
 } // namespace meshfree
+
+// KernelShapes.h numbers the plain-arithmetic weights like KernelType (device code cannot see the enum class).
+static_assert(meshfree::kPlainWendland == static_cast<int>(meshfree::KernelType::Wendland) &&
+    meshfree::kPlainPoly6 == static_cast<int>(meshfree::KernelType::Poly6) &&
+    meshfree::kPlainW3 == static_cast<int>(meshfree::KernelType::W3) &&
+    meshfree::kPlainW4 == static_cast<int>(meshfree::KernelType::W4) &&
+    meshfree::kPlainW5 == static_cast<int>(meshfree::KernelType::W5) &&
+    meshfree::kPlainLucy == static_cast<int>(meshfree::KernelType::Lucy) &&
+    meshfree::kPlainSpiky == static_cast<int>(meshfree::KernelType::Spiky) &&
+    meshfree::kPlainCubicSpline == static_cast<int>(meshfree::KernelType::CubicSpline),
+  "KernelShapes.h's PlainWeight must follow KernelType");

@@ -41,6 +41,8 @@
 #ifndef meshfree_Kernels_h
 #define meshfree_Kernels_h
 
+#include "Common/KernelShapes.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -148,14 +150,13 @@ private:
 // Inline evaluation (hot loops).
 inline double Kernel::Shape(double q) const
 {
-  const double u = 1.0 - q;
   switch (this->Kind)
   {
     case KernelType::Gaussian:
     case KernelType::W2:
       return std::exp(-this->GaussExponent * q * q) - this->TaperOffset;
     case KernelType::Wendland:
-      return u * u * u * u * (4.0 * q + 1.0);
+      return WendlandShape(q);
     case KernelType::InverseDistance:
       return 1.0 / (q * q + this->EpsilonSquared) - this->TaperOffset;
     case KernelType::Poly6:
@@ -166,12 +167,12 @@ inline double Kernel::Shape(double q) const
     case KernelType::W3:
     case KernelType::W5:
     case KernelType::CubicSpline:
-      return q <= 0.5 ? 1.0 - 6.0 * q * q * u : 2.0 * u * u * u;
+      return CubicSplineShape(q);
     case KernelType::W4:
     case KernelType::Lucy:
-      return (1.0 + 3.0 * q) * u * u * u;
+      return LucyShape(q);
     case KernelType::Spiky:
-      return u * u * u;
+      return SpikyShape(q);
     case KernelType::Viscosity:
     {
       const double qc = std::max(q, kMinimumQ);
@@ -247,10 +248,7 @@ inline double Kernel::ValueSquared(double r2) const
     case KernelType::InverseDistance:
       return this->Normalization * (1.0 / (q2 + this->EpsilonSquared) - this->TaperOffset);
     case KernelType::Poly6:
-    {
-      const double s = 1.0 - q2;
-      return this->Normalization * s * s * s;
-    }
+      return Poly6ValueSquared(this->Normalization, q2);
     default:
       return this->Normalization * this->Shape(std::sqrt(q2));
   }

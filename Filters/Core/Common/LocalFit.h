@@ -21,6 +21,7 @@
 #define meshfree_LocalFit_h
 
 #include "Common/Kernels.h"
+#include "Common/MLSFastPath.h"
 #include "Common/NeighborGrid.h"
 #include "Common/PolynomialBasis.h"
 
@@ -39,8 +40,7 @@ namespace meshfree
 constexpr double kMaxCondition = 1e10;
 /// MLS: the moving fit uses at least this many neighbours per basis term (see Approximation.h).
 constexpr int kMinimumNeighborsPerTerm = 2;
-/// Below this LDLT pivot ratio the fast path is trusted; above it the eigen-decomposition decides.
-constexpr double kFastPathRatio = 1e6;
+// kFastPathRatio (below this pivot ratio the fast path is trusted) is in MLSFastPath.h.
 
 /// Orthonormal intrinsic axes of a cloud: the first Dimension rows of Axes span it.
 struct LocalFrame
@@ -167,90 +167,23 @@ bool SolveMoment(Eigen::Matrix<double, Q, Q>& M, const MatB& B, MatY& Y, bool ex
 /**
  * SolveMoment for the MLS hot loop: M (Q x Q, row-major, upper triangle filled) is equilibrated and
  * factored by a hand-unrolled Cholesky (its pivots d_i satisfy lambda_min <= d_i <= lambda_max, so
- * max d / min d is again a lower bound of the condition number); the first r columns of the identity are
- * solved for, Y[c * Q + a]. The eigen-decomposition path of SolveMoment decides when the pivots are not
- * clearly fine or an exact condition number is asked for.
+ * max d / min d is again a lower bound of the condition number); the first r <= R columns of the identity
+ * are solved for, Y[c * Q + a]. The eigen-decomposition path of SolveMoment decides when the pivots are not
+ * clearly fine or an exact condition number is asked for. The equilibration and the Cholesky are the shared
+ * MESHFREE_HD code of MLSFastPath.h (the CUDA kernels run the same).
  */
-template <int Q>
+template <int Q, int R = Q>
 bool SolveMomentIdentity(double* M, int r, bool exactCondition, double* Y, double& condition)
 {
   double s[Q];
-  if (!EquilibrationScales<Q>([M](int i) { return M[i * Q + i]; }, s, condition))
+  if (!mls::EquilibrateMoment<Q>(M, s))
   {
+    condition = std::numeric_limits<double>::infinity();
     return false;
   }
-  for (int i = 0; i < Q; ++i)
+  if (!exactCondition && mls::CholeskyIdentitySolve<Q, R>(M, s, r, Y, condition))
   {
-    for (int j = i; j < Q; ++j)
-    {
-      M[i * Q + j] *= s[i] * s[j];
-      M[j * Q + i] = M[i * Q + j];
-    }
-  }
-  if (!exactCondition)
-  {
-    double L[Q * Q];
-    double dmin = std::numeric_limits<double>::infinity(), dmax = 0.0;
-    bool ok = true;
-    for (int j = 0; j < Q && ok; ++j)
-    {
-      double d = M[j * Q + j];
-      for (int k = 0; k < j; ++k)
-      {
-        d -= L[j * Q + k] * L[j * Q + k];
-      }
-      if (!(d > 0.0))
-      {
-        ok = false;
-        break;
-      }
-      dmin = std::min(dmin, d);
-      dmax = std::max(dmax, d);
-      const double ljj = std::sqrt(d);
-      L[j * Q + j] = ljj;
-      const double inv = 1.0 / ljj;
-      for (int i = j + 1; i < Q; ++i)
-      {
-        double v = M[i * Q + j];
-        for (int k = 0; k < j; ++k)
-        {
-          v -= L[i * Q + k] * L[j * Q + k];
-        }
-        L[i * Q + j] = v * inv;
-      }
-    }
-    if (ok && dmax < kFastPathRatio * dmin)
-    {
-      condition = dmax / dmin;
-      for (int c = 0; c < r; ++c)
-      {
-        // Solve L L^T z = S e_c, then y = S z.
-        double z[Q];
-        for (int i = 0; i < Q; ++i)
-        {
-          double v = (i == c) ? s[c] : 0.0;
-          for (int k = 0; k < i; ++k)
-          {
-            v -= L[i * Q + k] * z[k];
-          }
-          z[i] = v / L[i * Q + i];
-        }
-        for (int i = Q - 1; i >= 0; --i)
-        {
-          double v = z[i];
-          for (int k = i + 1; k < Q; ++k)
-          {
-            v -= L[k * Q + i] * z[k];
-          }
-          z[i] = v / L[i * Q + i];
-        }
-        for (int i = 0; i < Q; ++i)
-        {
-          Y[c * Q + i] = s[i] * z[i];
-        }
-      }
-      return true;
-    }
+    return true;
   }
   Eigen::Matrix<double, Q, Q> m = Eigen::Map<const Eigen::Matrix<double, Q, Q, Eigen::RowMajor>>(M);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Q, Q>> eig;
@@ -324,33 +257,19 @@ bool MLSShapeFunctions(const double* xi, const double* w, const double* dw, int 
   for (int j = 0; j < n; ++j)
   {
     double* p = rows + static_cast<size_t>(j) * Q;
-    Basis::Evaluate(xi + 3 * j, p);
-    const double wj = w[j];
-    for (int a = 0; a < Q; ++a)
-    {
-      const double wp = wj * p[a];
-      for (int b = a; b < Q; ++b)
-      {
-        moment[a * Q + b] += wp * p[b];
-      }
-    }
+    mls::EvaluateBasis<D, M>(xi + 3 * j, p);
+    mls::AccumulateMoment<Q>(p, w[j], moment);
   }
-  constexpr int R = (M > 0) ? D + 1 : 1;
+  constexpr int R = mls::MLSColumns<D, M>::Value;
   const int r = gradient ? R : 1;
   double y[Q * R];
-  if (!SolveMomentIdentity<Q>(moment, r, exactCondition, y, condition))
+  if (!SolveMomentIdentity<Q, R>(moment, r, exactCondition, y, condition))
   {
     return false;
   }
   for (int j = 0; j < n; ++j)
   {
-    const double* p = rows + static_cast<size_t>(j) * Q;
-    double v = 0.0;
-    for (int a = 0; a < Q; ++a)
-    {
-      v += p[a] * y[a];
-    }
-    phi[j] = w[j] * v;
+    phi[j] = w[j] * mls::ShapeDot<Q>(rows + static_cast<size_t>(j) * Q, y);
   }
   if (gradient && M > 0)
   {
@@ -360,13 +279,7 @@ bool MLSShapeFunctions(const double* xi, const double* w, const double* dw, int 
       double* out = dphi + static_cast<size_t>(c - 1) * n;
       for (int j = 0; j < n; ++j)
       {
-        const double* p = rows + static_cast<size_t>(j) * Q;
-        double v = 0.0;
-        for (int a = 0; a < Q; ++a)
-        {
-          v += p[a] * yc[a];
-        }
-        out[j] = w[j] * v;
+        out[j] = w[j] * mls::ShapeDot<Q>(rows + static_cast<size_t>(j) * Q, yc);
       }
     }
   }
