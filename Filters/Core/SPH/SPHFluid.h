@@ -63,9 +63,10 @@
 // Storage is structure of arrays: one array per attribute (position and velocity are xyz triplets, the layout
 // the shared NeighborGrid reads). Neighbour lists are rebuilt every step from the grid with its batched query
 // (NeighborGrid::FindWithinRadiusForAllPoints: cell by cell, the candidate cells gathered once for all the
-// particles of a cell; rows identical to per-particle queries), then every pass streams through the lists. Every ReorderInterval steps the particle arrays are permuted into
-// the grid's Z-order so that neighbours are close in memory. Everything the future depends on is in SPHState, so
-// a state restored from a cache continues bit-identically, whatever the number of threads.
+// particles of a cell; rows identical to per-particle queries), then every pass streams through the lists. Every
+// ReorderInterval steps the particle arrays are permuted into the grid's Z-order so that neighbours are close in
+// memory. Everything the future depends on is in SPHState, so a state restored from a cache continues bit-identically,
+// whatever the number of threads.
 //
 // Back ends (SetBackend): the per-particle arithmetic is shared MESHFREE_HD code (SPH/SPHPhysics.h,
 // SPH/SPHDensity.h); the CPU loops (SPHFluid.cxx) feed it CSR neighbour rows, the CUDA integrator

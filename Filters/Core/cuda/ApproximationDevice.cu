@@ -5,6 +5,7 @@
 
 #include "Approximation/MLSDevicePoint.h"
 #include "cuda/Device.h"
+#include "cuda/DeviceBuffer.cuh"
 
 #include <cuda_runtime.h>
 
@@ -59,53 +60,6 @@ __global__ void MLSKernel(CloudView cloud, FitConstants fc, ProbeView probes, Ou
   }
 }
 
-bool Check(cudaError_t status, const char* what, std::string* error)
-{
-  if (status == cudaSuccess)
-  {
-    return true;
-  }
-  if (error)
-  {
-    *error = std::string(what) + ": " + cudaGetErrorName(status) + " (" + cudaGetErrorString(status) + ")";
-  }
-  return false;
-}
-
-/// A device allocation freed on destruction.
-template <class T>
-struct Buffer
-{
-  T* Data = nullptr;
-  std::size_t Count = 0;
-  Buffer() = default;
-  Buffer(const Buffer&) = delete;
-  Buffer& operator=(const Buffer&) = delete;
-  ~Buffer() { cudaFree(this->Data); }
-  bool Allocate(std::size_t count, std::string* error)
-  {
-    if (this->Count >= count && this->Data)
-    {
-      return true;
-    }
-    cudaFree(this->Data);
-    this->Data = nullptr;
-    this->Count = 0;
-    if (!Check(cudaMalloc(&this->Data, sizeof(T) * (count > 0 ? count : 1)), "cudaMalloc", error))
-    {
-      return false;
-    }
-    this->Count = count;
-    return true;
-  }
-  bool Upload(const T* host, std::size_t count, std::string* error)
-  {
-    return this->Allocate(count, error) &&
-      (count == 0 ||
-        Check(cudaMemcpy(this->Data, host, sizeof(T) * count, cudaMemcpyHostToDevice), "cudaMemcpy", error));
-  }
-};
-
 template <int D, int M>
 void Launch(
   long long count, const CloudView& cloud, const FitConstants& fc, const ProbeView& probes, const OutputView& out)
@@ -117,10 +71,10 @@ void Launch(
 
 struct MLSDevice::State
 {
-  Buffer<double> Points, Values, Probes, OutValues, OutGradients, OutConditions;
-  Buffer<int> Ids, OutNeighbors;
-  Buffer<long long> Cells;
-  Buffer<unsigned char> OutNeedsCPU;
+  DeviceBuffer<double> Points, Values, Probes, OutValues, OutGradients, OutConditions;
+  DeviceBuffer<int> Ids, OutNeighbors;
+  DeviceBuffer<long long> Cells;
+  DeviceBuffer<unsigned char> OutNeedsCPU;
   CloudView Cloud{};
   MLSDeviceOptions Options;
   bool Ready = false;
@@ -227,10 +181,10 @@ bool MLSDevice::State::Run(const double* xyz, const ImageGeometry* image, std::i
   const std::int64_t chunk = std::min<std::int64_t>(m, ChunkPoints);
   const std::size_t cs = static_cast<std::size_t>(chunk);
   const bool gradients = this->Options.Gradients && out.Gradients;
-  if (!this->OutValues.Allocate(cs * std::max(C, 1), error) ||
-    !this->OutGradients.Allocate(gradients ? 3 * cs * std::max(C, 1) : 1, error) ||
-    !this->OutNeighbors.Allocate(cs, error) || !this->OutConditions.Allocate(cs, error) ||
-    !this->OutNeedsCPU.Allocate(cs, error) || (xyz && !this->Probes.Allocate(3 * cs, error)))
+  if (!this->OutValues.Reserve(cs * std::max(C, 1), error) ||
+    !this->OutGradients.Reserve(gradients ? 3 * cs * std::max(C, 1) : 1, error) ||
+    !this->OutNeighbors.Reserve(cs, error) || !this->OutConditions.Reserve(cs, error) ||
+    !this->OutNeedsCPU.Reserve(cs, error) || (xyz && !this->Probes.Reserve(3 * cs, error)))
   {
     return false;
   }

@@ -2,6 +2,7 @@
 #include "cuda/SPHDensity.h"
 
 #include "cuda/Device.h"
+#include "cuda/DeviceBuffer.cuh"
 
 #include <cuda_runtime.h>
 
@@ -27,36 +28,6 @@ __global__ void DensityKernel(std::int64_t n, const double* x, const std::int64_
   }
 }
 
-bool Check(cudaError_t status, const char* what, std::string* error)
-{
-  if (status == cudaSuccess)
-  {
-    return true;
-  }
-  if (error)
-  {
-    *error = std::string(what) + ": " + cudaGetErrorName(status) + " (" + cudaGetErrorString(status) + ")";
-  }
-  return false;
-}
-
-/// A device array freed on scope exit.
-template <class T>
-struct DeviceArray
-{
-  T* Data = nullptr;
-  ~DeviceArray() { cudaFree(this->Data); }
-  bool Upload(const T* host, std::int64_t count, std::string* error)
-  {
-    const std::size_t bytes = sizeof(T) * static_cast<std::size_t>(count > 0 ? count : 1);
-    if (!Check(cudaMalloc(&this->Data, bytes), "cudaMalloc", error))
-    {
-      return false;
-    }
-    return count == 0 || Check(cudaMemcpy(this->Data, host, sizeof(T) * count, cudaMemcpyHostToDevice), "cudaMemcpy",
-                            error);
-  }
-};
 /// Whether a device is there to run on; otherwise `error` gets the reason.
 bool Usable(std::string* error)
 {
@@ -104,13 +75,13 @@ bool SPHDensityFromHost(std::int64_t n, const double* x, const std::int64_t* flu
   {
     return true;
   }
-  DeviceArray<double> dx, dbx, drho;
-  DeviceArray<std::int64_t> dfs, dbs;
-  DeviceArray<std::int32_t> dfn, dbn;
+  DeviceBuffer<double> dx, dbx, drho;
+  DeviceBuffer<std::int64_t> dfs, dbs;
+  DeviceBuffer<std::int32_t> dfn, dbn;
   const bool uploaded = dx.Upload(x, 3 * n, error) && dfs.Upload(fluidStart, n + 1, error) &&
     dfn.Upload(fluidNeighbors, fluidStart[n], error) && dbx.Upload(boundaryX, 3 * nb, error) &&
     dbs.Upload(boundaryStart, n + 1, error) && dbn.Upload(boundaryNeighbors, boundaryStart[n], error) &&
-    Check(cudaMalloc(&drho.Data, sizeof(double) * n), "cudaMalloc", error);
+    drho.Reserve(n, error);
   if (!uploaded ||
     !SPHDensityOnDevice(n, dx.Data, dfs.Data, dfn.Data, dbx.Data, dbs.Data, dbn.Data, constants, drho.Data, error))
   {

@@ -9,6 +9,7 @@
 #include "SPH/SPHFluid.h"
 #include "SPH/SPHGridPasses.h"
 #include "cuda/Device.h"
+#include "cuda/DeviceBuffer.cuh"
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cuda_runtime.h>
@@ -26,63 +27,10 @@ constexpr int BlockSize = 128;
 constexpr int ReduceBlock = 256;
 constexpr int ReduceBlocks = 256; // partial results of a reduction, merged on the host (order-independent maxima)
 
-bool Check(cudaError_t status, const char* what, std::string* error)
-{
-  if (status == cudaSuccess)
-  {
-    return true;
-  }
-  if (error)
-  {
-    *error = std::string(what) + ": " + cudaGetErrorName(status) + " (" + cudaGetErrorString(status) + ")";
-  }
-  return false;
-}
-
 unsigned Blocks(std::int64_t n)
 {
   return static_cast<unsigned>((n + BlockSize - 1) / BlockSize);
 }
-
-/// A device array that keeps its allocation when resized to a smaller or equal count.
-template <class T>
-struct Buffer
-{
-  T* Data = nullptr;
-  std::size_t Capacity = 0;
-  Buffer() = default;
-  Buffer(const Buffer&) = delete;
-  Buffer& operator=(const Buffer&) = delete;
-  ~Buffer() { cudaFree(this->Data); }
-  bool Reserve(std::size_t count, std::string* error)
-  {
-    count = count > 0 ? count : 1;
-    if (count <= this->Capacity)
-    {
-      return true;
-    }
-    cudaFree(this->Data);
-    this->Data = nullptr;
-    this->Capacity = 0;
-    if (!Check(cudaMalloc(&this->Data, sizeof(T) * count), "cudaMalloc", error))
-    {
-      return false;
-    }
-    this->Capacity = count;
-    return true;
-  }
-  bool Upload(const T* host, std::size_t count, std::string* error)
-  {
-    return this->Reserve(count, error) &&
-      (count == 0 ||
-        Check(cudaMemcpy(this->Data, host, sizeof(T) * count, cudaMemcpyHostToDevice), "cudaMemcpy", error));
-  }
-  bool Download(T* host, std::size_t count, std::string* error) const
-  {
-    return count == 0 ||
-      Check(cudaMemcpy(host, this->Data, sizeof(T) * count, cudaMemcpyDeviceToHost), "cudaMemcpy", error);
-  }
-};
 
 using Span = GridCellRange32;
 using GridView = GridCells;
@@ -288,27 +236,27 @@ struct SPHDevice::Internals
 {
   SPHConstants C;
   std::int64_t N = 0;
-  Buffer<double> X, V, A, Rho, P, Term, Inverse, X2, V2, A2;
-  Buffer<std::int64_t> Id, Id2;
+  DeviceBuffer<double> X, V, A, Rho, P, Term, Inverse, X2, V2, A2;
+  DeviceBuffer<std::int64_t> Id, Id2;
 
   // The fluid grid, rebuilt from the positions for every force evaluation and reorder.
   GridView Fluid{};
-  Buffer<double> Sorted;
-  Buffer<std::uint64_t> Keys, SortedKeys, Spread;
-  Buffer<std::int32_t> Index, Order;
-  Buffer<Span> Cells;
-  Buffer<unsigned char> SortTemp;
+  DeviceBuffer<double> Sorted;
+  DeviceBuffer<std::uint64_t> Keys, SortedKeys, Spread;
+  DeviceBuffer<std::int32_t> Index, Order;
+  DeviceBuffer<Span> Cells;
+  DeviceBuffer<unsigned char> SortTemp;
   std::int64_t SpreadDims[3] = { 0, 0, 0 };
   int KeyBits = 0;
-  Buffer<Bounds> BoundsPartials;
-  Buffer<SPHExtremes> ExtremesPartials;
+  DeviceBuffer<Bounds> BoundsPartials;
+  DeviceBuffer<SPHExtremes> ExtremesPartials;
 
   // The wall dummies: static, their grid copied once.
   GridView Wall{};
   std::int64_t WallCount = 0;
-  Buffer<double> WallX, WallSorted, WallTerm;
-  Buffer<std::int32_t> WallOrder;
-  Buffer<Span> WallCells;
+  DeviceBuffer<double> WallX, WallSorted, WallTerm;
+  DeviceBuffer<std::int32_t> WallOrder;
+  DeviceBuffer<Span> WallCells;
 
   bool BuildGrid(std::string* error);
 };
