@@ -14,16 +14,7 @@
 
 namespace
 {
-int failures = 0;
-
-void Check(bool ok, const std::string& what)
-{
-  if (!ok)
-  {
-    std::printf("FAILED: %s\n", what.c_str());
-    ++failures;
-  }
-}
+sphtest::Checks Check;
 
 /// The initial state with every particle moved by up to 0.3 dx per axis and given a velocity of up to 0.5 m/s
 /// per axis (y untouched in 2D).
@@ -47,13 +38,10 @@ meshfree::SPHState Disordered(meshfree::SPHFluid& fluid, int dimension, double d
 
 int main()
 {
-  std::string reason;
-  if (!meshfree::cuda::Available(&reason))
+  if (!sphtest::DevicePresent())
   {
-    std::printf("SKIPPED: %s\n", reason.c_str());
     return 77;
   }
-  std::printf("device: %s\n", meshfree::cuda::DeviceName().c_str());
   const meshfree::SPHKernelPair pairs[] = { meshfree::SPHKernelPair::Spiky, meshfree::SPHKernelPair::Poly6,
     meshfree::SPHKernelPair::Mueller };
   unsigned seed = 1;
@@ -91,6 +79,5 @@ int main()
       }
     }
   }
-  std::printf(failures == 0 ? "PASSED\n" : "%d FAILURES\n", failures);
-  return failures == 0 ? 0 : 1;
+  return Check.Exit();
 }

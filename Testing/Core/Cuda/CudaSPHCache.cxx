@@ -11,20 +11,11 @@
 
 int main()
 {
-  std::string reason;
-  if (!meshfree::cuda::Available(&reason))
+  if (!sphtest::DevicePresent())
   {
-    std::printf("SKIPPED: %s\n", reason.c_str());
     return 77;
   }
-  int failures = 0;
-  auto check = [&](bool ok, const std::string& what) {
-    if (!ok)
-    {
-      std::printf("FAILED: %s\n", what.c_str());
-      ++failures;
-    }
-  };
+  sphtest::Checks check;
   const meshfree::SPHParameters p = sphtest::DamBreak(3, 0.005, false, 0.0); // CFL steps, ~10,000 particles
   meshfree::SPHFluid cpu, device;
   cpu.Setup(p);
@@ -62,6 +53,5 @@ int main()
       expected != nullptr && next == k + 1 && sphtest::SameState(*expected, again, "from output " + std::to_string(k)),
       "restored output " + std::to_string(k) + " advanced again equals output " + std::to_string(k + 1));
   }
-  std::printf(failures == 0 ? "OK\n" : "%d FAILURES\n", failures);
-  return failures == 0 ? 0 : 1;
+  return check.Exit();
 }

@@ -13,16 +13,7 @@
 
 namespace
 {
-int failures = 0;
-
-void Check(bool ok, const std::string& what)
-{
-  if (!ok)
-  {
-    std::printf("FAILED: %s\n", what.c_str());
-    ++failures;
-  }
-}
+sphtest::Checks Check;
 
 /// The state after advancing to `target` on the CPU and on the device (Ok, and the device really ran).
 void Run(const meshfree::SPHParameters& p, double target, meshfree::SPHState& cpu, meshfree::SPHState& device,
@@ -44,13 +35,10 @@ void Run(const meshfree::SPHParameters& p, double target, meshfree::SPHState& cp
 
 int main()
 {
-  std::string reason;
-  if (!meshfree::cuda::Available(&reason))
+  if (!sphtest::DevicePresent())
   {
-    std::printf("SKIPPED: %s\n", reason.c_str());
     return 77;
   }
-  std::printf("device: %s\n", meshfree::cuda::DeviceName().c_str());
   const double dt = 2e-4;
   for (int dimension : { 2, 3 })
   {
@@ -94,6 +82,5 @@ int main()
     std::printf("obstacles: %s\n", b.BackendNote().c_str());
     Check(sphtest::SameState(cpu, device, "obstacles"), "obstacles: the CPU's result");
   }
-  std::printf(failures == 0 ? "OK\n" : "%d FAILURES\n", failures);
-  return failures == 0 ? 0 : 1;
+  return Check.Exit();
 }

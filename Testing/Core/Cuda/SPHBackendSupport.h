@@ -1,9 +1,10 @@
-// Shared by the SPH back-end tests (Cuda/CudaSPH*.cxx, CudaNoDevice.cxx): dam-break scenes and a bitwise
-// comparison of two states.
+// Shared by the SPH back-end tests (Cuda/CudaSPH*.cxx, CudaNoDevice.cxx): dam-break scenes, a bitwise comparison
+// of two states, the device check that makes a GPU test skip and the count of failed checks.
 #ifndef MeshFree_Testing_SPHBackendSupport_h
 #define MeshFree_Testing_SPHBackendSupport_h
 
 #include "SPH/SPHFluid.h"
+#include "cuda/Device.h"
 
 #include <cstdio>
 #include <cstring>
@@ -66,6 +67,39 @@ inline bool SameState(const meshfree::SPHState& a, const meshfree::SPHState& b, 
   check(SameBits(a.Id, b.Id), "Id");
   return same;
 }
+
+/// Whether a usable CUDA device is present (its name printed); otherwise prints "SKIPPED: <reason>" and the GPU
+/// test returns 77 (ctest's SKIP_RETURN_CODE).
+inline bool DevicePresent()
+{
+  std::string reason;
+  if (!meshfree::cuda::Available(&reason))
+  {
+    std::printf("SKIPPED: %s\n", reason.c_str());
+    return false;
+  }
+  std::printf("device: %s\n", meshfree::cuda::DeviceName().c_str());
+  return true;
+}
+
+/// The checks of a test program: Check(ok, what) prints each failure; Exit() is the program's exit status.
+struct Checks
+{
+  int Failures = 0;
+  void operator()(bool ok, const std::string& what)
+  {
+    if (!ok)
+    {
+      std::printf("FAILED: %s\n", what.c_str());
+      ++this->Failures;
+    }
+  }
+  int Exit() const
+  {
+    std::printf(this->Failures == 0 ? "OK\n" : "%d FAILURES\n", this->Failures);
+    return this->Failures == 0 ? 0 : 1;
+  }
+};
 
 } // namespace sphtest
 
