@@ -9,6 +9,7 @@
 // per-thread functions (SPH/SPHGridPasses.h) run over such a grid in host loops must give SPHFluid's density,
 // pressure and accelerations bit for bit (dam breaks in motion, 2D and 3D, Ideal and Tait, every force term).
 #include "Common/GridCell.h"
+#include "Common/GridCellView.h"
 #include "Common/NeighborGrid.h"
 #include "SPH/SPHFluid.h"
 #include "SPH/SPHGridPasses.h"
@@ -243,40 +244,6 @@ TEST(SPHDeviceEmulation, CandidateWalkListsNeighboursInTheRowsOrder)
 
 namespace
 {
-/// A NeighborGrid as the device's copy of the wall dummies' grid (cuda/SPHDevice.cu: Setup).
-meshfree::GridCells WallView(
-  const meshfree::NeighborGrid& grid, std::vector<std::int32_t>& order, std::vector<meshfree::GridCellRange32>& cells)
-{
-  meshfree::GridCells w{};
-  const Index m = grid.NumberOfValidPoints();
-  if (m == 0)
-  {
-    return w;
-  }
-  double bounds[6];
-  grid.GetBounds(bounds);
-  for (int a = 0; a < 3; ++a)
-  {
-    w.Origin[a] = bounds[2 * a];
-    w.Extent[a] = bounds[2 * a + 1] - bounds[2 * a];
-  }
-  w.Size = grid.CellSize();
-  w.Inverse = 1.0 / w.Size;
-  grid.GetGridDimensions(w.Dims);
-  order.assign(grid.SortedOrder().begin(), grid.SortedOrder().end());
-  const Index count = w.Dims[0] * w.Dims[1] * w.Dims[2];
-  cells.resize(static_cast<std::size_t>(count));
-  for (Index c = 0; c < count; ++c)
-  {
-    cells[c] = { static_cast<std::int32_t>(grid.Cells()[c].Begin), static_cast<std::int32_t>(grid.Cells()[c].End) };
-  }
-  w.Sorted = grid.SortedPoints();
-  w.Order = order.data();
-  w.Cells = cells.data();
-  w.Count = m;
-  return w;
-}
-
 template <class T>
 bool SameBits(const std::vector<T>& a, const std::vector<T>& b)
 {
@@ -329,7 +296,7 @@ TEST(SPHDeviceEmulation, GridPassesGiveTheCPUsForces)
       std::vector<meshfree::GridCellRange32> cells, wallCells;
       meshfree::GridCells fluidView;
       DeviceStyleBuild(state.Position, c.H, order, sorted, cells, fluidView);
-      const meshfree::GridCells wallView = WallView(solver.BoundaryNeighborGrid(), wallOrder, wallCells);
+      const meshfree::GridCells wallView = meshfree::GridCellView(solver.BoundaryNeighborGrid(), wallOrder, wallCells);
       ASSERT_GT(wallView.Count, 0);
       std::vector<double> rho(n), pressure(n), term(n), inverse(n), acc(3 * n);
       for (Index s = 0; s < n; ++s)

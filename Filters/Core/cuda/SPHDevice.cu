@@ -5,6 +5,7 @@
 #include "cuda/SPHDevice.h"
 
 #include "Common/GridCell.h"
+#include "Common/GridCellView.h"
 #include "Common/NeighborGrid.h"
 #include "SPH/SPHFluid.h"
 #include "SPH/SPHGridPasses.h"
@@ -404,25 +405,10 @@ bool SPHDevice::Setup(const SPHConstants& constants, const double* boundaryPosit
     }
     return false;
   }
+  std::vector<std::int32_t> order;
+  std::vector<Span> cells;
   GridView& w = d.Wall;
-  double bounds[6];
-  boundaryGrid.GetBounds(bounds);
-  for (int a = 0; a < 3; ++a)
-  {
-    w.Origin[a] = bounds[2 * a];
-    w.Extent[a] = bounds[2 * a + 1] - bounds[2 * a];
-  }
-  w.Size = boundaryGrid.CellSize();
-  w.Inverse = 1.0 / w.Size;
-  boundaryGrid.GetGridDimensions(w.Dims);
-  const std::int64_t cellCount = w.Dims[0] * w.Dims[1] * w.Dims[2];
-  std::vector<std::int32_t> order(boundaryGrid.SortedOrder().begin(), boundaryGrid.SortedOrder().end());
-  std::vector<Span> cells(static_cast<std::size_t>(cellCount));
-  const NeighborGrid::CellRange* ranges = boundaryGrid.Cells();
-  for (std::int64_t k = 0; k < cellCount; ++k)
-  {
-    cells[k] = Span{ static_cast<std::int32_t>(ranges[k].Begin), static_cast<std::int32_t>(ranges[k].End) };
-  }
+  w = GridCellView(boundaryGrid, order, cells);
   if (!d.WallX.Upload(boundaryPositions, 3 * boundaryCount, error) ||
     !d.WallSorted.Upload(boundaryGrid.SortedPoints(), 3 * boundaryCount, error) ||
     !d.WallOrder.Upload(order.data(), order.size(), error) || !d.WallCells.Upload(cells.data(), cells.size(), error) ||
@@ -430,10 +416,9 @@ bool SPHDevice::Setup(const SPHConstants& constants, const double* boundaryPosit
   {
     return false;
   }
-  w.Sorted = d.WallSorted.Data;
+  w.Sorted = d.WallSorted.Data; // the view's host pointers replaced by the device copies
   w.Order = d.WallOrder.Data;
   w.Cells = d.WallCells.Data;
-  w.Count = boundaryCount;
   return true;
 }
 
