@@ -5,6 +5,7 @@
 // the bits of the same points given explicitly. Auto stays on the CPU for small jobs; methods without a device path
 // say so when CUDA is asked for.
 #include "Approximation/Approximation.h"
+#include "StripCloud.h"
 #include "cuda/Device.h"
 
 #include <gtest/gtest.h>
@@ -26,32 +27,7 @@ struct Result
   ApproximationReport Report;
 };
 
-/// A cloud of n points: a tilted plane (dim 2) or a cube (dim 3), two components, and a nearly collinear strip
-/// of 40 points (its probes need the robust path or a fallback).
-void MakeCloud(int dim, std::vector<double>& xyz, std::vector<double>& values, unsigned seed)
-{
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const int n = 4000;
-  xyz.assign(3 * n, 0.0);
-  values.assign(2 * n, 0.0);
-  for (int i = 0; i < n; ++i)
-  {
-    double* x = &xyz[3 * i];
-    x[0] = u(rng);
-    x[1] = u(rng);
-    x[2] = dim == 3 ? u(rng) : 0.3 * x[0] + 0.1 * x[1] + 2.0;
-    if (i < 40)
-    {
-      x[0] = 2.0 + 1e-3 * i;
-      x[1] = 2.0 + 1e-9 * u(rng);
-      x[2] = dim == 3 ? 2.0 : 0.3 * x[0] + 0.1 * x[1] + 2.0;
-    }
-    values[2 * i] = std::sin(3.0 * x[0]) + x[1] * x[2];
-    values[2 * i + 1] = u(rng);
-  }
-}
-
+/// m probes over the cloud of MakeStripCloud, the first 20 on its strip.
 std::vector<double> Probes(int dim, int m, unsigned seed)
 {
   std::mt19937_64 rng(seed);
@@ -124,7 +100,7 @@ TEST(ApproximationBackend, CudaGivesTheCpuBits)
   for (int dim = 2; dim <= 3; ++dim)
   {
     std::vector<double> xyz, values;
-    MakeCloud(dim, xyz, values, 100 + dim);
+    meshfree::testing::MakeStripCloud(dim, 4000, xyz, values, 100 + dim);
     const int m = 3000;
     const std::vector<double> q = Probes(dim, m, 200 + dim);
     for (int degree = 1; degree <= 3; ++degree)
@@ -175,7 +151,7 @@ TEST(ApproximationBackend, CudaGivesTheCpuBits)
 TEST(ApproximationBackend, ImageProbesGiveTheBitsOfExplicitPoints)
 {
   std::vector<double> xyz, values;
-  MakeCloud(3, xyz, values, 7);
+  meshfree::testing::MakeStripCloud(3, 4000, xyz, values, 7);
   ImageGeometry image;
   const double origin[3] = { -1.05, -0.95, -1.0 }, spacing[3] = { 0.07, 0.09, 0.11 };
   const Index dims[3] = { 31, 23, 19 };
@@ -214,7 +190,7 @@ TEST(ApproximationBackend, ImageProbesGiveTheBitsOfExplicitPoints)
 TEST(ApproximationBackend, AutoAndOtherMethods)
 {
   std::vector<double> xyz, values;
-  MakeCloud(2, xyz, values, 9);
+  meshfree::testing::MakeStripCloud(2, 4000, xyz, values, 9);
   const std::vector<double> q = Probes(2, 100, 10);
   ApproximationOptions o;
   o.Backend = ApproximationBackend::Auto; // 100 points x 20 neighbours: far below kAutoDeviceWork

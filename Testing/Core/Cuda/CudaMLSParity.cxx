@@ -5,6 +5,7 @@
 // generated on the device give the bits of the same points uploaded; the Approximator with Backend CUDA gives the
 // CPU's bits for all points, its report saying "CUDA (...)". Exit 77 (skipped) without a usable device.
 #include "Approximation/Approximation.h"
+#include "StripCloud.h"
 #include "cuda/ApproximationDevice.h"
 #include "cuda/Device.h"
 
@@ -35,36 +36,13 @@ bool SameBits(const double* a, const double* b, size_t n)
   return std::memcmp(a, b, sizeof(double) * n) == 0;
 }
 
-void MakeCloud(int dim, int n, std::vector<double>& xyz, std::vector<double>& values, unsigned seed)
-{
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  xyz.assign(3 * n, 0.0);
-  values.assign(2 * n, 0.0);
-  for (int i = 0; i < n; ++i)
-  {
-    double* x = &xyz[3 * i];
-    x[0] = u(rng);
-    x[1] = u(rng);
-    x[2] = dim == 3 ? u(rng) : 0.3 * x[0] + 0.1 * x[1] + 2.0;
-    if (i < 40) // the strip
-    {
-      x[0] = 2.0 + 1e-3 * i;
-      x[1] = 2.0 + 1e-9 * u(rng);
-      x[2] = dim == 3 ? 2.0 : 0.3 * x[0] + 0.1 * x[1] + 2.0;
-    }
-    values[2 * i] = std::sin(3.0 * x[0]) + x[1] * x[2];
-    values[2 * i + 1] = u(rng);
-  }
-}
-
 /// The device's own outputs next to the CPU's for m probes (the first 20 on the strip).
 void CompareDirect(int dim, int degree, KernelType weight)
 {
   const std::string what =
     "dim " + std::to_string(dim) + " degree " + std::to_string(degree) + " " + KernelName(weight);
   std::vector<double> xyz, values;
-  MakeCloud(dim, 20000, xyz, values, 10 * dim + degree);
+  meshfree::testing::MakeStripCloud(dim, 20000, xyz, values, 10 * dim + degree);
   const int m = 20000;
   std::mt19937_64 rng(99);
   std::uniform_real_distribution<double> u(-1.1, 1.1);
