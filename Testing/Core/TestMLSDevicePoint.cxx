@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Approximation/MLSDevicePoint.h, the per-point code the CUDA kernel runs, executed here on the CPU (it is
-// MESHFREE_HD): its k-nearest search returns exactly NeighborGrid::FindKNearest's (d2, index)-ordered points (random
+// MESHFREE_HD): its k-nearest search returns exactly NeighborGrid::FindKNearest's (d2, position)-ordered points (random
 // and lattice clouds with many distance ties, queries inside, outside and far away, k from 1 to 64 and above the
 // cloud size); the whole point (search, weights, fast path, values and gradients) gives the Approximator's bits
 // wherever it does not hand the point back, and hands back every probe of a nearly collinear strip.
@@ -121,7 +121,7 @@ TEST(MLSDevicePoint, KNearestIsFindKNearest)
     x = u(rng);
   }
   CheckKNearest(random, Queries(300, -1.3, 1.3, 4), "random cube");
-  // A lattice (many equal distances: the index decides) with queries on and between lattice points.
+  // A lattice (many equal distances: the position decides) with queries on and between lattice points.
   std::vector<double> lattice;
   for (int i = 0; i < 12; ++i)
   {

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // NeighborGrid against brute force: radius results as exact index sets, k-nearest results as exact
-// (distance, index) lists. The grid breaks distance ties by the original index, so the brute-force
-// reference (the first k of all points sorted by (distance, index)) is unique even with duplicates.
+// (distance, index) lists. The grid breaks distance ties by position (x, y, z) and exact duplicates by the
+// original index, so the brute-force reference (the first k of all points sorted that way) is unique even with
+// duplicates.
 #include "Common/NeighborGrid.h"
 #include "Common/Parallel.h"
 
@@ -52,7 +53,9 @@ std::vector<std::pair<double, Index>> SortedDistances(const Cloud& c, const doub
       all.emplace_back(Distance2(&c[3 * i], x), i);
     }
   }
-  std::sort(all.begin(), all.end());
+  std::sort(all.begin(), all.end(), [&c](const std::pair<double, Index>& a, const std::pair<double, Index>& b) {
+    return NeighborGrid::NeighborBefore(a.first, &c[3 * a.second], a.second, b.first, &c[3 * b.second], b.second);
+  });
   return all;
 }
 

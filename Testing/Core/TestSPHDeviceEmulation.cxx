@@ -3,7 +3,7 @@
 // NeighborGrid::ChooseCells for the bounds, cell keys from NeighborGrid::MortonTables and GridAxisCell, a stable
 // sort of (key, index) (the device's CUB radix sort is stable), cell ranges from runs of equal keys; and the
 // neighbour walk GridForEachCandidate (Common/GridCell.h, the function the kernels call). They must reproduce
-// NeighborGrid's SortedOrder() and Cells(), and list every point's neighbours within h in the order of
+// NeighborGrid's SortedOrder() and Cells() (the solver's grid, SetCellsByPosition(false)), and list every point's neighbours within h in the order of
 // FindWithinRadiusForAllPoints' rows (fluid) and of FindWithinRadius (arbitrary positions, the wall dummies'
 // queries), so that the device's sums add the same terms in the same order as the CPU's. Then the kernels'
 // per-thread functions (SPH/SPHGridPasses.h) run over such a grid in host loops must give SPHFluid's density,
@@ -137,6 +137,7 @@ TEST(SPHDeviceEmulation, DeviceStyleBuildReproducesTheGrid)
   {
     const Index n = static_cast<Index>(x.size() / 3);
     meshfree::NeighborGrid grid;
+    grid.SetCellsByPosition(false); // the SPH integrator's layout
     ASSERT_TRUE(grid.Build(x.data(), n, h));
     std::vector<std::int32_t> order;
     std::vector<double> sorted;
@@ -178,6 +179,7 @@ TEST(SPHDeviceEmulation, CandidateWalkListsNeighboursInTheRowsOrder)
   {
     const Index n = static_cast<Index>(x.size() / 3);
     meshfree::NeighborGrid grid;
+    grid.SetCellsByPosition(false); // the SPH integrator's layout
     ASSERT_TRUE(grid.Build(x.data(), n, h));
     std::vector<Index> offsets;
     std::vector<std::int32_t> rows;

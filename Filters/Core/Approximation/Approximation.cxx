@@ -462,13 +462,28 @@ void Approximator::SortById(FitScratch& s, size_t n)
   }
 }
 
+void Approximator::SortNeighbors(FitScratch& s, size_t n) const
+{
+  s.Candidates.resize(n);
+  for (size_t j = 0; j < n; ++j)
+  {
+    s.Candidates[j] = { s.Dist2[j], s.Ids[j] };
+  }
+  std::sort(s.Candidates.begin(), s.Candidates.end(), this->NeighborOrder());
+  for (size_t j = 0; j < n; ++j)
+  {
+    s.Dist2[j] = s.Candidates[j].first;
+    s.Ids[j] = s.Candidates[j].second;
+  }
+}
+
 int Approximator::Neighbors(const double x[3], int k, double radius, FitScratch& s, double& h) const
 {
   if (radius > 0.0)
   {
     this->Points.FindWithinRadius(x, radius, s.Ids, &s.Dist2);
     h = radius;
-    SortById(s, s.Ids.size());
+    this->SortNeighbors(s, s.Ids.size());
     return static_cast<int>(s.Ids.size());
   }
   if (s.Ids.size() < static_cast<size_t>(k))
@@ -481,7 +496,7 @@ int Approximator::Neighbors(const double x[3], int k, double radius, FitScratch&
   {
     // Consecutive evaluation points are usually close. The k nearest points of the previous query lie
     // within d_k(previous) + |x - previous| of x (triangle inequality), so one radius query of that size
-    // holds at least k points, and a selection by (distance, index) gives exactly the k nearest - faster
+    // holds at least k points, and a selection in the neighbour order gives exactly the k nearest - faster
     // than the shell search. A far jump makes the ball too big: then the exact k-nearest search is used.
     const double step = std::sqrt((x[0] - s.LastQuery[0]) * (x[0] - s.LastQuery[0]) +
       (x[1] - s.LastQuery[1]) * (x[1] - s.LastQuery[1]) + (x[2] - s.LastQuery[2]) * (x[2] - s.LastQuery[2]));
@@ -504,8 +519,9 @@ int Approximator::Neighbors(const double x[3], int k, double radius, FitScratch&
         s.Candidates[j] = { s.Dist2[j], s.Ids[j] };
       }
       // Afterwards the k-th nearest sits at k - 1 (also when count == k: the farthest goes last) and
-      // the nearer ones before it, unordered.
-      std::nth_element(s.Candidates.begin(), s.Candidates.begin() + (k - 1), s.Candidates.end());
+      // the nearer ones before it, sorted as FindKNearest() gives them.
+      std::nth_element(s.Candidates.begin(), s.Candidates.begin() + (k - 1), s.Candidates.end(), this->NeighborOrder());
+      std::sort(s.Candidates.begin(), s.Candidates.begin() + (k - 1), this->NeighborOrder());
       for (int j = 0; j < k; ++j)
       {
         s.Dist2[j] = s.Candidates[j].first;
@@ -528,7 +544,6 @@ int Approximator::Neighbors(const double x[3], int k, double radius, FitScratch&
   {
     s.RadiusGuess = farthest;
     std::copy(x, x + 3, s.LastQuery);
-    SortById(s, static_cast<size_t>(found));
   }
   h = this->Opts.SupportFactor * farthest;
   if (!(h > 0.0))

@@ -52,6 +52,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace meshfree
@@ -277,11 +278,22 @@ private:
   PointResult PUPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const;
   /// The k nearest points of x (radius <= 0; h = SupportFactor x the k-th distance) or those within radius
-  /// (h = radius), in s.Ids / s.Dist2 ordered by index: the fits' sums then do not depend on how the
-  /// neighbours were found (warm start or not, which points a distributed part holds), only on the points.
+  /// (h = radius), in s.Ids / s.Dist2 in the grid's neighbour order (distance, then position): the fits'
+  /// sums then do not depend on how the neighbours were found (warm start or not, which points a distributed
+  /// part holds) nor on the input's order, only on the points.
   int Neighbors(const double x[3], int k, double radius, FitScratch& s, double& h) const;
   /// Orders the first n of s.Ids / s.Dist2 by index.
   static void SortById(FitScratch& s, size_t n);
+  /// Orders the first n of s.Ids / s.Dist2 (cloud points) in NeighborGrid's neighbour order.
+  void SortNeighbors(FitScratch& s, size_t n) const;
+  /// That order on (squared distance, index) pairs of cloud points.
+  auto NeighborOrder() const
+  {
+    const double* xyz = this->Coordinates.data();
+    return [xyz](const std::pair<double, Index>& a, const std::pair<double, Index>& b) {
+      return NeighborGrid::NeighborBefore(a.first, xyz + 3 * a.second, a.second, b.first, xyz + 3 * b.second, b.second);
+    };
+  }
   /// Keeps those of the n neighbours s.Ids/s.Dist2 of x with a positive, finite weight W(r / h)^2, packed at
   /// the front of s.Ids and s.Weights, with their local coordinates (x_j - x) / h in the frame in s.Xi;
   /// returns how many. s must hold room for n (FitScratch::Reserve).

@@ -176,7 +176,7 @@ bool Approximator::PreparePU(const double* xyz, Index count)
       for (int attempt = 0; attempt < 2 && degrees[node] < 0; ++attempt, h *= 2.0)
       {
         this->Points.FindWithinRadius(x, h, s.Ids, &s.Dist2);
-        SortById(s, s.Ids.size());
+        this->SortNeighbors(s, s.Ids.size());
         const int n = static_cast<int>(s.Ids.size());
         if (attempt == 0)
         {

@@ -2,13 +2,14 @@
 // MeshFree core: one MLS evaluation point of the device path (cuda/ApproximationDevice.cu runs it, one thread per
 // point), as MESHFREE_HD code on plain views of the cloud, so that the CPU tests run the very same search and fit
 // (Testing/Core/TestMLSDevicePoint.cxx) although no GPU is at hand. It reproduces Approximator::MLSShape/MLSPoint
-// for the case the fast path finishes: the k nearest by (d2, original index) found in NeighborGrid's cell-sorted
-// layout (rings of cells around the query's cell, pruned by the k-th distance), h = SupportFactor x d_k, the
-// neighbours in index order, the plain weights of KernelShapes.h, the moment solve of MLSFastPath.h, values and
+// for the case the fast path finishes: the k nearest in NeighborGrid's neighbour order (d2, then position, then
+// original index: GridNeighborBefore) found in its cell-sorted layout (rings of cells around the query's cell,
+// pruned by the k-th distance), h = SupportFactor x d_k, the neighbours in that order, the plain weights of KernelShapes.h, the moment solve of MLSFastPath.h, values and
 // gradients summed in the CPU's order. Anything else returns false: the caller hands the point to the CPU.
 #ifndef meshfree_MLSDevicePoint_h
 #define meshfree_MLSDevicePoint_h
 
+#include "Common/GridCell.h"
 #include "Common/HostDevice.h"
 #include "Common/KernelShapes.h"
 #include "Common/MLSFastPath.h"
@@ -62,13 +63,17 @@ struct OutputView
   unsigned char* NeedsCPU; // Count (OR-ed over the component passes)
 };
 
-MESHFREE_HD inline bool Before(double d2, int id, double e2, int eid)
+/// (d2, sorted position p) before (e2, q) in NeighborGrid's neighbour order.
+MESHFREE_HD inline bool Before(const CloudView& cloud, double d2, int p, double e2, int q)
 {
-  return d2 < e2 || (d2 == e2 && id < eid);
+  return d2 < e2 ||
+    (d2 == e2 &&
+      GridPointBefore(cloud.Points + 3 * static_cast<long long>(p), cloud.Ids[p],
+        cloud.Points + 3 * static_cast<long long>(q), cloud.Ids[q]));
 }
 
-/// The k nearest cloud points of x by (d2, original index), in bd2/bid/bpos sorted that way; returns how many
-/// (fewer than k only when the cloud has fewer points), or -1 when the search gave up (too far from the cloud).
+/// The k nearest cloud points of x in NeighborGrid's neighbour order, in bd2/bid/bpos sorted that way; returns how
+/// many (fewer than k only when the cloud has fewer points), or -1 when the search gave up (too far from the cloud).
 MESHFREE_HD inline int KNearest(const CloudView& cloud, const double x[3], int k, double* bd2, int* bid, int* bpos)
 {
   long long c[3];
@@ -126,12 +131,13 @@ MESHFREE_HD inline int KNearest(const CloudView& cloud, const double x[3], int k
             const double e0 = q[0] - x[0], e1 = q[1] - x[1], e2 = q[2] - x[2];
             const double d2 = e0 * e0 + e1 * e1 + e2 * e2;
             const int id = cloud.Ids[p];
+            const int pos = static_cast<int>(p);
             int j;
             if (found < k)
             {
               j = found++;
             }
-            else if (Before(d2, id, bd2[k - 1], bid[k - 1]))
+            else if (Before(cloud, d2, pos, bd2[k - 1], bpos[k - 1]))
             {
               j = k - 1;
             }
@@ -139,7 +145,7 @@ MESHFREE_HD inline int KNearest(const CloudView& cloud, const double x[3], int k
             {
               continue;
             }
-            while (j > 0 && Before(d2, id, bd2[j - 1], bid[j - 1]))
+            while (j > 0 && Before(cloud, d2, pos, bd2[j - 1], bpos[j - 1]))
             {
               bd2[j] = bd2[j - 1];
               bid[j] = bid[j - 1];
@@ -148,7 +154,7 @@ MESHFREE_HD inline int KNearest(const CloudView& cloud, const double x[3], int k
             }
             bd2[j] = d2;
             bid[j] = id;
-            bpos[j] = static_cast<int>(p);
+            bpos[j] = pos;
           }
         }
       }
@@ -190,23 +196,7 @@ MESHFREE_HD inline bool MLSFast(
   {
     return false; // the CPU's all-coincident rule
   }
-  // The CPU sums over the neighbours in index order.
-  for (int j = 1; j < found; ++j)
-  {
-    const double d2 = bd2[j];
-    const int id = bid[j], pos = bpos[j];
-    int i = j;
-    while (i > 0 && bid[i - 1] > id)
-    {
-      bd2[i] = bd2[i - 1];
-      bid[i] = bid[i - 1];
-      bpos[i] = bpos[i - 1];
-      --i;
-    }
-    bd2[i] = d2;
-    bid[i] = id;
-    bpos[i] = pos;
-  }
+  // The CPU sums over the neighbours in this (the neighbour) order too.
   const double invH = 1.0 / h;
   const double invH2 = invH * invH;
   int m = 0; // bd2 now holds the weights of the m neighbours kept, bpos their sorted positions

@@ -12,6 +12,36 @@
 namespace meshfree
 {
 
+/// The order of the points a neighbour query returns, the same on the CPU and the device: ascending squared
+/// distance d2; points at the same distance by position (x, then y, then z ascending), so that which of several
+/// equidistant points is taken (the k-th nearest of a lattice point) and the order of the sums over them do not
+/// depend on the input's order; exact duplicates (equal coordinates) by original index `id`, the only rule left
+/// that does (equal positions: it matters only when coincident points carry different values).
+template <class Id>
+MESHFREE_HD inline bool GridPointBefore(const double* p, Id id, const double* q, Id qid)
+{
+  if (p[0] != q[0])
+  {
+    return p[0] < q[0];
+  }
+  if (p[1] != q[1])
+  {
+    return p[1] < q[1];
+  }
+  if (p[2] != q[2])
+  {
+    return p[2] < q[2];
+  }
+  return id < qid;
+}
+
+/// (d2, p, id) before (e2, q, qid) in the neighbour order (see GridPointBefore).
+template <class Id>
+MESHFREE_HD inline bool GridNeighborBefore(double d2, const double* p, Id id, double e2, const double* q, Id qid)
+{
+  return d2 < e2 || (d2 == e2 && GridPointBefore(p, id, q, qid));
+}
+
 /// Cell coordinate, along one axis, of a point at `rel` from the grid's origin, clamped into [0, dim).
 MESHFREE_HD inline std::int64_t GridAxisCell(double rel, double inverseSize, std::int64_t dim)
 {

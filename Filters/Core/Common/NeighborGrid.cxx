@@ -58,14 +58,22 @@ inline Index ChunkBegin(Index n, int c, int chunks)
   return static_cast<Index>((static_cast<long double>(n) * c) / chunks);
 }
 
-/// (d, id) orders before (e, jd): by distance, ties by original index.
-inline bool Before(double d, Index id, double e, Index jd)
+/// The neighbour order of Common/GridCell.h (distance, then x, y, z, then original index) on sorted positions:
+/// (d, s) before (e, t). Only equal distances read the coordinates.
+struct PositionOrder
 {
-  return d < e || (d == e && id < jd);
-}
+  const double* Xyz;
+  const Index* Order;
 
-/// Max-heap on (dist2, ids) pairs, largest (distance, index) at the root.
-void SiftDown(double* dist2, Index* ids, Index root, Index count)
+  bool operator()(double d, Index s, double e, Index t) const
+  {
+    return d < e || (d == e && GridPointBefore(this->Xyz + 3 * s, this->Order[s], this->Xyz + 3 * t, this->Order[t]));
+  }
+};
+
+/// Max-heap on (dist2, ids) pairs (ids: sorted positions), largest in the neighbour order at the root.
+template <class Less>
+void SiftDown(double* dist2, Index* ids, Index root, Index count, const Less& before)
 {
   const double d = dist2[root];
   const Index id = ids[root];
@@ -76,11 +84,11 @@ void SiftDown(double* dist2, Index* ids, Index root, Index count)
     {
       break;
     }
-    if (child + 1 < count && Before(dist2[child], ids[child], dist2[child + 1], ids[child + 1]))
+    if (child + 1 < count && before(dist2[child], ids[child], dist2[child + 1], ids[child + 1]))
     {
       ++child;
     }
-    if (!Before(d, id, dist2[child], ids[child]))
+    if (!before(d, id, dist2[child], ids[child]))
     {
       break;
     }
@@ -92,14 +100,15 @@ void SiftDown(double* dist2, Index* ids, Index root, Index count)
   ids[root] = id;
 }
 
-void SiftUp(double* dist2, Index* ids, Index node)
+template <class Less>
+void SiftUp(double* dist2, Index* ids, Index node, const Less& before)
 {
   const double d = dist2[node];
   const Index id = ids[node];
   while (node > 0)
   {
     const Index parent = (node - 1) / 2;
-    if (!Before(dist2[parent], ids[parent], d, id))
+    if (!before(dist2[parent], ids[parent], d, id))
     {
       break;
     }
@@ -111,15 +120,69 @@ void SiftUp(double* dist2, Index* ids, Index node)
   ids[node] = id;
 }
 
-/// Turns a max-heap into an array sorted ascending by (distance, index).
-void SortHeap(double* dist2, Index* ids, Index count)
+/// Turns a max-heap into an array sorted ascending in the neighbour order.
+template <class Less>
+void SortHeap(double* dist2, Index* ids, Index count, const Less& less)
 {
   for (Index end = count - 1; end > 0; --end)
   {
     std::swap(dist2[0], dist2[end]);
     std::swap(ids[0], ids[end]);
-    SiftDown(dist2, ids, 0, end);
+    SiftDown(dist2, ids, 0, end, less);
   }
+}
+
+/// Sorts the points of each cell (sorted positions [Begin, End), in original index order) by position
+/// (GridPointBefore: x, y, z, then original index), moving their coordinates and original indices together.
+void SortCellsByPosition(const NeighborGrid::CellRange* cells, Index cellCount, double* xyz, Index* order, Index serialBelow)
+{
+  struct Point
+  {
+    double X[3];
+    Index Id;
+  };
+  ParallelFor(
+    cellCount, 4096,
+    [&](Index begin, Index end) {
+      std::vector<Point> large; // cells of more than 24 points (rare: degenerate clouds)
+      for (Index c = begin; c < end; ++c)
+      {
+        const Index b = cells[c].Begin, e = cells[c].End;
+        if (e - b > 24)
+        {
+          large.resize(static_cast<std::size_t>(e - b));
+          for (Index s = b; s < e; ++s)
+          {
+            large[s - b] = Point{ { xyz[3 * s], xyz[3 * s + 1], xyz[3 * s + 2] }, order[s] };
+          }
+          std::sort(large.begin(), large.end(),
+            [](const Point& p, const Point& q) { return GridPointBefore(p.X, p.Id, q.X, q.Id); });
+          for (Index s = b; s < e; ++s)
+          {
+            const Point& p = large[s - b];
+            std::copy(p.X, p.X + 3, xyz + 3 * s);
+            order[s] = p.Id;
+          }
+          continue;
+        }
+        for (Index s = b + 1; s < e; ++s) // insertion sort
+        {
+          const Point p{ { xyz[3 * s], xyz[3 * s + 1], xyz[3 * s + 2] }, order[s] };
+          Index t = s;
+          for (; t > b && GridPointBefore(p.X, p.Id, xyz + 3 * (t - 1), order[t - 1]); --t)
+          {
+            std::copy(xyz + 3 * (t - 1), xyz + 3 * t, xyz + 3 * t);
+            order[t] = order[t - 1];
+          }
+          if (t != s)
+          {
+            std::copy(p.X, p.X + 3, xyz + 3 * t);
+            order[t] = p.Id;
+          }
+        }
+      }
+    },
+    serialBelow);
 }
 
 /// Stable parallel LSD radix sort of v[0, m) by bits [lowBit, lowBit + bits). v and scratch are swapped
@@ -576,6 +639,10 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
       }
     },
     serialBelow);
+  if (this->CellsByPosition)
+  {
+    SortCellsByPosition(cells, cellCount, sorted, order, serialBelow);
+  }
   return true;
 }
 
@@ -777,18 +844,18 @@ struct Candidates
   static constexpr int Capacity = 256;
   static constexpr int MaxRanges = 64;
   double Dist2[Capacity + 8];
-  Index Ids[Capacity + 8]; // sorted positions while collecting, then original indices
+  Index Ids[Capacity + 8]; // sorted positions
   double SortedDist2[Capacity];
   Index SortedIds[Capacity];
   int Bucket[Capacity];
   int Start[2 * Capacity + 1];
   int Count = 0;
 
-  /// Sorts the first k candidates (0 <= Dist2 <= cut) by (distance, index) into SortedDist2/SortedIds: a
+  /// Sorts the first k candidates (0 <= Dist2 <= cut) in the neighbour order into SortedDist2/SortedIds: a
   /// counting sort into 2n buckets by Dist2 / cut (for points spread evenly in a ball, at most about 1.5
   /// per bucket on average), then an insertion sort that only fixes the order inside the buckets that
   /// hold the first k. Unlike a comparison sort of random keys (or a heap), few branches mispredict.
-  void Sort(double cut, int k)
+  void Sort(double cut, int k, const PositionOrder& before)
   {
     const int n = this->Count;
     const int buckets = 2 * n;
@@ -817,7 +884,7 @@ struct Candidates
       const double d = this->SortedDist2[i];
       const Index id = this->SortedIds[i];
       int j = i;
-      for (; j > 0 && Before(d, id, this->SortedDist2[j - 1], this->SortedIds[j - 1]); --j)
+      for (; j > 0 && before(d, id, this->SortedDist2[j - 1], this->SortedIds[j - 1]); --j)
       {
         this->SortedDist2[j] = this->SortedDist2[j - 1];
         this->SortedIds[j] = this->SortedIds[j - 1];
@@ -836,20 +903,20 @@ struct SortedBest
   struct Entry
   {
     double Dist2;
-    Index Id;
+    Index Pos; // sorted position
   };
   Entry Best[Capacity];
   double* Dist2;
   Index* Ids;
-  const Index* Order;
+  PositionOrder Before;
   int K;
   int Count = 0;
   double Worst = Infinity; // k-th squared distance once k candidates are known
 
-  SortedBest(double* dist2, Index* ids, const Index* order, int k)
+  SortedBest(double* dist2, Index* ids, const PositionOrder& order, int k)
     : Dist2(dist2)
     , Ids(ids)
-    , Order(order)
+    , Before(order)
     , K(k)
   {
   }
@@ -860,11 +927,10 @@ struct SortedBest
     {
       return;
     }
-    const Index id = this->Order[s];
     int slot = this->Count;
     if (slot == this->K)
     {
-      if (d2 == this->Worst && id > this->Best[slot - 1].Id)
+      if (d2 == this->Worst && !this->Before(d2, s, d2, this->Best[slot - 1].Pos))
       {
         return;
       }
@@ -874,11 +940,11 @@ struct SortedBest
     {
       ++this->Count;
     }
-    for (; slot > 0 && Before(d2, id, this->Best[slot - 1].Dist2, this->Best[slot - 1].Id); --slot)
+    for (; slot > 0 && this->Before(d2, s, this->Best[slot - 1].Dist2, this->Best[slot - 1].Pos); --slot)
     {
       this->Best[slot] = this->Best[slot - 1];
     }
-    this->Best[slot] = Entry{ d2, id };
+    this->Best[slot] = Entry{ d2, s };
     if (this->Count == this->K)
     {
       this->Worst = this->Best[this->K - 1].Dist2;
@@ -889,7 +955,7 @@ struct SortedBest
     for (int i = 0; i < this->Count; ++i)
     {
       this->Dist2[i] = this->Best[i].Dist2;
-      this->Ids[i] = this->Best[i].Id;
+      this->Ids[i] = this->Before.Order[this->Best[i].Pos];
     }
     return this->Count;
   }
@@ -899,8 +965,8 @@ struct SortedBest
 struct HeapBest
 {
   double* Dist2;
-  Index* Ids;
-  const Index* Order;
+  Index* Ids; // sorted positions until Finish()
+  PositionOrder Before;
   int K;
   int Count = 0;
   double Worst = Infinity;
@@ -911,18 +977,17 @@ struct HeapBest
     {
       return;
     }
-    const Index id = this->Order[s];
     if (this->Count < this->K)
     {
       this->Dist2[this->Count] = d2;
-      this->Ids[this->Count] = id;
-      SiftUp(this->Dist2, this->Ids, this->Count++);
+      this->Ids[this->Count] = s;
+      SiftUp(this->Dist2, this->Ids, this->Count++, this->Before);
     }
-    else if (Before(d2, id, this->Dist2[0], this->Ids[0]))
+    else if (this->Before(d2, s, this->Dist2[0], this->Ids[0]))
     {
       this->Dist2[0] = d2;
-      this->Ids[0] = id;
-      SiftDown(this->Dist2, this->Ids, 0, this->K);
+      this->Ids[0] = s;
+      SiftDown(this->Dist2, this->Ids, 0, this->K, this->Before);
     }
     if (this->Count == this->K)
     {
@@ -931,7 +996,11 @@ struct HeapBest
   }
   int Finish()
   {
-    SortHeap(this->Dist2, this->Ids, this->Count);
+    SortHeap(this->Dist2, this->Ids, this->Count, this->Before);
+    for (int i = 0; i < this->Count; ++i)
+    {
+      this->Ids[i] = this->Before.Order[this->Ids[i]];
+    }
     return this->Count;
   }
 };
@@ -1152,13 +1221,18 @@ void NeighborGrid::FindWithinRadiusPositions(
 void NeighborGrid::FindWithinRadiusSorted(
   const double x[3], double radius, std::vector<Index>& ids, std::vector<double>& dist2) const
 {
-  this->FindWithinRadius(x, radius, ids, &dist2);
+  this->FindWithinRadiusPositions(x, radius, ids, dist2);
   const Index count = static_cast<Index>(ids.size());
+  const PositionOrder order{ this->Sorted.data(), this->Order.data() };
   for (Index i = count / 2 - 1; i >= 0; --i) // heap sort: in place, no allocation
   {
-    SiftDown(dist2.data(), ids.data(), i, count);
+    SiftDown(dist2.data(), ids.data(), i, count, order);
   }
-  SortHeap(dist2.data(), ids.data(), count);
+  SortHeap(dist2.data(), ids.data(), count, order);
+  for (Index& id : ids)
+  {
+    id = this->Order[id];
+  }
 }
 
 Index NeighborGrid::CountWithinRadius(const double x[3], double radius) const
@@ -1245,13 +1319,12 @@ int NeighborGrid::NearestWithinEstimate(const double x[3], const double rel[3], 
     c.Count = Filter(xyz, ranges, rangeCount, x, cut, c.Dist2, c.Ids);
     if (c.Count >= k)
     {
-      for (int i = 0; i < c.Count; ++i)
-      {
-        c.Ids[i] = this->Order[c.Ids[i]];
-      }
-      c.Sort(cut, k);
+      c.Sort(cut, k, PositionOrder{ xyz, this->Order.data() });
       std::copy(c.SortedDist2, c.SortedDist2 + k, dist2);
-      std::copy(c.SortedIds, c.SortedIds + k, ids);
+      for (int i = 0; i < k; ++i)
+      {
+        ids[i] = this->Order[c.SortedIds[i]];
+      }
       return k;
     }
     cut *= dimension == 3 ? 1.5874 : (dimension == 2 ? 2.0 : 4.0); // twice the expected count
@@ -1379,12 +1452,13 @@ int NeighborGrid::SearchNearest(const double x[3], const double rel[3], const In
 int NeighborGrid::NearestExact(
   const double x[3], const double rel[3], const Index cq[3], int k, Index* ids, double* dist2) const
 {
+  const PositionOrder order{ this->Sorted.data(), this->Order.data() };
   if (k <= SortedBest::Capacity)
   {
-    SortedBest best(dist2, ids, this->Order.data(), k);
+    SortedBest best(dist2, ids, order, k);
     return this->SearchNearest(x, rel, cq, best);
   }
-  HeapBest best{ dist2, ids, this->Order.data(), k };
+  HeapBest best{ dist2, ids, order, k };
   return this->SearchNearest(x, rel, cq, best);
 }
 

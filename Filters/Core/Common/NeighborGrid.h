@@ -5,13 +5,22 @@
  *        Z-order (Morton order), with radius and k-nearest-neighbour queries at arbitrary positions.
  *
  * Build() copies the valid points (finite x, y and z) into one packed array (interleaved x, y, z) sorted
- * by the Morton code of their cell, keeps the permutation back to the caller's numbering, and records for
- * every cell (dense array, indexed by cell) the range of sorted positions it holds. Queries stream
- * through contiguous memory cell by cell; consecutive sorted points are spatial neighbours, so loops over
- * SortedOrder() are cache friendly too.
+ * by the Morton code of their cell and, inside a cell, by position (x, then y, then z; exact duplicates by
+ * original index), keeps the permutation back to the caller's numbering, and records for every cell (dense
+ * array, indexed by cell) the range of sorted positions it holds. Queries stream through contiguous memory
+ * cell by cell; consecutive sorted points are spatial neighbours, so loops over SortedOrder() are cache
+ * friendly too.
+ *
+ * Order independence: the layout (hence the order in which radius queries list points and loops over the
+ * sorted points sum) depends only on the set of positions, not on their input order; the k nearest and
+ * every sorted result break distance ties by position (NeighborBefore()). Permuting the input changes only
+ * which of several exactly coincident points comes first (by original index). SetCellsByPosition(false)
+ * keeps the points of a cell in original index order instead (the SPH integrator's grid, whose particle
+ * order is the solver's own and which the CUDA integrator rebuilds by a stable sort of the cell keys).
  *
  * Build is parallel (Common/Parallel.h), O(n): one pass for the bounds, one for the cell keys, an LSD radix sort of
- * packed (cell key, index) words, a gather of the coordinates and a pass for the cell ranges.
+ * packed (cell key, index) words, a gather of the coordinates, a pass for the cell ranges and one sorting each
+ * cell's few points by position.
  *
  * Geometry
  * - Cells are cubes of edge CellSize() anchored at the minimum of the valid points' bounds; cell
@@ -30,8 +39,9 @@
  *   that order in double precision (no FMA), so they equal a plain brute-force loop's bit for bit.
  * - FindWithinRadius() returns every valid point with d2 <= radius^2 (closed ball), unsorted (in cell
  *   order; FindWithinRadiusSorted() sorts them). A point of the cloud finds itself.
- * - FindKNearest() returns the k valid points that come first in the order (d2, original index), sorted
- *   that way: results are deterministic even when distances tie. It first guesses a radius from the
+ * - FindKNearest() returns the k valid points that come first in the neighbour order (d2, then x, y, z,
+ *   then original index: NeighborBefore()), sorted that way: which of several equidistant points is taken
+ *   depends on their positions only, never on the input's order. It first guesses a radius from the
  *   local density (the k nearest lie within it when it holds at least k points) and filters the cells
  *   in reach with a vector kernel; when the guess fails (sparse or very uneven regions, queries far from
  *   the cloud, large k) it falls back to an exact search over shells of cells around the query, pruning
@@ -44,6 +54,8 @@
  */
 #ifndef meshfree_NeighborGrid_h
 #define meshfree_NeighborGrid_h
+
+#include "Common/GridCell.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -105,7 +117,20 @@ public:
   /// Average occupancy targeted by the automatic cell size (default 8; used by the next Build()).
   void SetPointsPerCell(double pointsPerCell);
   double GetPointsPerCell() const { return this->PointsPerCell; }
+  /// Whether the next Build() sorts the points of each cell by position (default) or keeps them in original
+  /// index order (see the class comment).
+  void SetCellsByPosition(bool byPosition) { this->CellsByPosition = byPosition; }
+  bool GetCellsByPosition() const { return this->CellsByPosition; }
   ///@}
+
+  /// The neighbour order of every query: (d2, p, id) comes before (e2, q, qid) when d2 < e2, or the distances
+  /// are equal and p comes first by (x, y, z), or the positions are equal too and id < qid. Callers that
+  /// select or sort neighbours themselves (e.g. among the points of a radius query) use it to agree with
+  /// FindKNearest() and stay independent of the input's order. p and q are the points' coordinates.
+  static bool NeighborBefore(double d2, const double* p, Index id, double e2, const double* q, Index qid)
+  {
+    return GridNeighborBefore(d2, p, id, e2, q, qid);
+  }
 
   /// Distances are filtered with an AVX-512 or AVX2 kernel when the CPU has one (chosen at run time; results
   /// are bit-identical to the portable code). SetVectorized(false) forces the portable code for every grid,
@@ -144,14 +169,14 @@ public:
   /// sorted order read it contiguously.
   void FindWithinRadiusPositions(
     const double x[3], double radius, std::vector<Index>& positions, std::vector<double>& dist2) const;
-  /// As FindWithinRadius(), sorted ascending by (squared distance, original index).
+  /// As FindWithinRadius(), sorted ascending in the neighbour order (NeighborBefore()).
   void FindWithinRadiusSorted(
     const double x[3], double radius, std::vector<Index>& ids, std::vector<double>& dist2) const;
   /// Number of valid points within `radius` of x (distance <= radius), without collecting them.
   Index CountWithinRadius(const double x[3], double radius) const;
 
-  /// The k nearest valid points to x (all valid points when there are fewer than k), sorted ascending by
-  /// (squared distance, original index). ids and dist2 must hold min(k, NumberOfValidPoints()) entries.
+  /// The k nearest valid points to x (all valid points when there are fewer than k), the first in the
+  /// neighbour order (NeighborBefore()) and sorted that way. ids and dist2 must hold min(k, NumberOfValidPoints()) entries.
   /// Returns the number found.
   int FindKNearest(const double x[3], int k, Index* ids, double* dist2) const;
   /// As above; ids and dist2 are resized to the number found (their capacity is kept).
@@ -181,7 +206,9 @@ public:
 
   ///@{
   /// The Morton-sorted layout. SortedOrder()[s] is the original index of the point at sorted position s
-  /// (valid points only); SortedPoints() holds their coordinates, interleaved x, y, z, in that order.
+  /// (valid points only; cells in Morton order, the points of a cell by position or, with
+  /// SetCellsByPosition(false), by original index); SortedPoints() holds their coordinates, interleaved x,
+  /// y, z, in that order.
   /// Cells(): the sorted-position range of each cell (Begin == End when empty), indexed by
   /// i + nx * (j + ny * k) with GetGridDimensions() (nx, ny, nz).
   const std::vector<Index>& SortedOrder() const { return this->Order; }
@@ -218,6 +245,7 @@ private:
   int SearchNearest(const double x[3], const double rel[3], const Index cell[3], Best& best) const;
 
   double PointsPerCell = 8.0;
+  bool CellsByPosition = true;
   Index NumberOfInputPoints = 0;
   double Origin[3] = { 0.0, 0.0, 0.0 }; // minimum of the valid points' bounds
   double Extent[3] = { 0.0, 0.0, 0.0 };

@@ -98,6 +98,7 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
   {
     return;
   }
+  this->Grid.SetCellsByPosition(false); // the particles' own order: the CUDA integrator rebuilds it (SPHDevice.h)
   this->Grid.Build(state.Position.data(), n, this->H);
   this->BuildNeighborLists(state, true);
   const double* x = state.Position.data();
@@ -232,6 +233,7 @@ void SPHFluid::Enforce(SPHState& state, Index begin, Index end) const
 void SPHFluid::Reorder(SPHState& state)
 {
   const Index n = state.Size();
+  this->Grid.SetCellsByPosition(false); // the particles' own order: the CUDA integrator rebuilds it (SPHDevice.h)
   this->Grid.Build(state.Position.data(), n, this->H);
   const std::vector<Index>& order = this->Grid.SortedOrder();
   if (static_cast<Index>(order.size()) != n)
@@ -422,6 +424,7 @@ std::vector<int> SPHFluid::NeighborCounts(const SPHState& state)
   {
     return counts;
   }
+  this->Grid.SetCellsByPosition(false); // the particles' own order: the CUDA integrator rebuilds it (SPHDevice.h)
   this->Grid.Build(state.Position.data(), n, this->H);
   std::vector<std::vector<Index>> threadIds(MaxThreads());
   std::vector<std::vector<double>> threadDistances(MaxThreads());

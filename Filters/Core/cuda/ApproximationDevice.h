@@ -1,9 +1,9 @@
 // MLS approximation on the CUDA device: the fast path of the moving fits (Common/MLSFastPath.h, the code the CPU
 // runs), one thread per evaluation point, with a k-nearest search in the host grid's cell-sorted layout that finds
-// the same (distance, index)-ordered neighbours as NeighborGrid::FindKNearest. Points the fast path cannot finish
-// (a fit needing the eigen-decomposition or a fallback, a far query, non-finite results) are flagged NeedsCPU;
-// the Approximator finishes them with its robust chain. Declared without any CUDA type; without CUDA or without a
-// device every call returns false with the reason.
+// the same neighbours, in the same order (distance, then position), as NeighborGrid::FindKNearest. Points the fast
+// path cannot finish (a fit needing the eigen-decomposition or a fallback, a far query, non-finite results) are
+// flagged NeedsCPU; the Approximator finishes them with its robust chain. Declared without any CUDA type; without
+// CUDA or without a device every call returns false with the reason.
 #ifndef MeshFree_cuda_ApproximationDevice_h
 #define MeshFree_cuda_ApproximationDevice_h
 

@@ -6,7 +6,8 @@
 // Each step does what the CPU loops of SPHFluid.cxx do, with the same shared arithmetic (SPH/SPHPhysics.h,
 // SPH/SPHDensity.h): the neighbour grid is rebuilt on the device with NeighborGrid's geometry (origin = minimum
 // of the points, NeighborGrid::ChooseCells for cellSize = h, its compact Morton keys, a stable radix sort of
-// (cell key, index), so the sorted order equals NeighborGrid::SortedOrder()), and every sum visits its
+// (cell key, index), so the sorted order equals the SortedOrder() of the solver's grid, which keeps each cell's
+// points in index order: NeighborGrid::SetCellsByPosition(false)), and every sum visits its
 // neighbours in the order of the CPU's rows (cells in (z, y, x) order, points of a cell in sorted order), so the
 // sums match bit for bit. Wall dummies come from a device copy of the static boundary grid.
 #ifndef MeshFree_cuda_SPHDevice_h
