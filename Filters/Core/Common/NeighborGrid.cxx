@@ -6,6 +6,7 @@
 #include "Common/Parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -132,57 +133,44 @@ void SortHeap(double* dist2, Index* ids, Index count, const Less& less)
   }
 }
 
-/// Sorts the points of each cell (sorted positions [Begin, End), in original index order) by position
+/// Sorts the points of one cell (sorted positions [begin, end), in original index order) by position
 /// (GridPointBefore: x, y, z, then original index), moving their coordinates and original indices together.
-void SortCellsByPosition(const NeighborGrid::CellRange* cells, Index cellCount, double* xyz, Index* order, Index serialBelow)
+using PointRecord = std::pair<std::array<double, 3>, Index>;
+void SortCellByPosition(double* xyz, Index* order, Index begin, Index end, std::vector<PointRecord>& large)
 {
-  struct Point
+  if (end - begin > 24) // rare: degenerate clouds
   {
-    double X[3];
-    Index Id;
-  };
-  ParallelFor(
-    cellCount, 4096,
-    [&](Index begin, Index end) {
-      std::vector<Point> large; // cells of more than 24 points (rare: degenerate clouds)
-      for (Index c = begin; c < end; ++c)
-      {
-        const Index b = cells[c].Begin, e = cells[c].End;
-        if (e - b > 24)
-        {
-          large.resize(static_cast<std::size_t>(e - b));
-          for (Index s = b; s < e; ++s)
-          {
-            large[s - b] = Point{ { xyz[3 * s], xyz[3 * s + 1], xyz[3 * s + 2] }, order[s] };
-          }
-          std::sort(large.begin(), large.end(),
-            [](const Point& p, const Point& q) { return GridPointBefore(p.X, p.Id, q.X, q.Id); });
-          for (Index s = b; s < e; ++s)
-          {
-            const Point& p = large[s - b];
-            std::copy(p.X, p.X + 3, xyz + 3 * s);
-            order[s] = p.Id;
-          }
-          continue;
-        }
-        for (Index s = b + 1; s < e; ++s) // insertion sort
-        {
-          const Point p{ { xyz[3 * s], xyz[3 * s + 1], xyz[3 * s + 2] }, order[s] };
-          Index t = s;
-          for (; t > b && GridPointBefore(p.X, p.Id, xyz + 3 * (t - 1), order[t - 1]); --t)
-          {
-            std::copy(xyz + 3 * (t - 1), xyz + 3 * t, xyz + 3 * t);
-            order[t] = order[t - 1];
-          }
-          if (t != s)
-          {
-            std::copy(p.X, p.X + 3, xyz + 3 * t);
-            order[t] = p.Id;
-          }
-        }
-      }
-    },
-    serialBelow);
+    large.resize(static_cast<std::size_t>(end - begin));
+    for (Index s = begin; s < end; ++s)
+    {
+      large[s - begin] = { { xyz[3 * s], xyz[3 * s + 1], xyz[3 * s + 2] }, order[s] };
+    }
+    std::sort(large.begin(), large.end(), [](const auto& p, const auto& q) {
+      return GridPointBefore(p.first.data(), p.second, q.first.data(), q.second);
+    });
+    for (Index s = begin; s < end; ++s)
+    {
+      std::copy(large[s - begin].first.begin(), large[s - begin].first.end(), xyz + 3 * s);
+      order[s] = large[s - begin].second;
+    }
+    return;
+  }
+  for (Index s = begin + 1; s < end; ++s) // insertion sort
+  {
+    const double p[3] = { xyz[3 * s], xyz[3 * s + 1], xyz[3 * s + 2] };
+    const Index id = order[s];
+    Index t = s;
+    for (; t > begin && GridPointBefore(p, id, xyz + 3 * (t - 1), order[t - 1]); --t)
+    {
+      std::copy(xyz + 3 * (t - 1), xyz + 3 * t, xyz + 3 * t);
+      order[t] = order[t - 1];
+    }
+    if (t != s)
+    {
+      std::copy(p, p + 3, xyz + 3 * t);
+      order[t] = id;
+    }
+  }
 }
 
 /// Stable parallel LSD radix sort of v[0, m) by bits [lowBit, lowBit + bits). v and scratch are swapped
@@ -575,10 +563,27 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   keys = this->CellKeys.data();
   Index* order = this->Order.data();
   double* sorted = this->Sorted.data();
+  // The gather's chunks start at the first point of a cell, so that each sorts its cells by position as it
+  // completes them (while they are in cache).
+  auto cellKeyOf = [&](Index s) { return packed ? keys[s] >> keyShift : pairs[s].first; };
+  std::vector<Index> gatherBegin(static_cast<std::size_t>(chunks) + 1, m);
+  gatherBegin[0] = 0;
+  for (int c = 1; c < chunks; ++c)
+  {
+    Index b = std::max(ChunkBegin(m, c, chunks), gatherBegin[c - 1]);
+    while (b < m && cellKeyOf(b) == cellKeyOf(b - 1))
+    {
+      ++b;
+    }
+    gatherBegin[c] = b;
+  }
+  const bool byPosition = this->CellsByPosition;
   ParallelFor(chunks, 1, [&](Index begin, Index end) {
+    std::vector<PointRecord> large; // scratch of SortCellByPosition
     for (int c = static_cast<int>(begin); c < end; ++c)
     {
-      for (Index s = ChunkBegin(m, c, chunks), e = ChunkBegin(m, c + 1, chunks); s < e; ++s)
+      Index cellBegin = gatherBegin[c];
+      for (Index s = gatherBegin[c], e = gatherBegin[c + 1]; s < e; ++s)
       {
         Index i;
         if (packed)
@@ -599,6 +604,11 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
         sorted[3 * s] = xyz[3 * i];
         sorted[3 * s + 1] = xyz[3 * i + 1];
         sorted[3 * s + 2] = xyz[3 * i + 2];
+        if (byPosition && (s + 1 == e || cellKeyOf(s + 1) != keys[s])) // the cell's last point
+        {
+          SortCellByPosition(sorted, order, cellBegin, s + 1, large);
+          cellBegin = s + 1;
+        }
       }
     }
   });
@@ -639,10 +649,6 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
       }
     },
     serialBelow);
-  if (this->CellsByPosition)
-  {
-    SortCellsByPosition(cells, cellCount, sorted, order, serialBelow);
-  }
   return true;
 }
 
