@@ -201,21 +201,39 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
     ParallelThreshold);
 }
 
+Index SPHFluid::ObstacleSample(const double* x, std::vector<Index>& ids, std::vector<double>& d2, double& depth) const
+{
+  const int found = this->ObstacleGrid.FindKNearest(x, 8, ids, d2);
+  Index best = -1;
+  for (int j = 0; j < found && d2[j] == d2[0]; ++j)
+  {
+    const double* s = &this->ObstaclePosition[3 * ids[j]];
+    const double* n = &this->ObstacleNormal[3 * ids[j]];
+    const double d = (x[0] - s[0]) * n[0] + (x[1] - s[1]) * n[1] + (x[2] - s[2]) * n[2];
+    if (best < 0 || d > depth)
+    {
+      best = ids[j];
+      depth = d;
+    }
+  }
+  return best;
+}
+
 void SPHFluid::Enforce(SPHState& state, Index begin, Index end) const
 {
   const bool obstacles = !this->ObstaclePosition.empty();
-  std::vector<Index> nearest(1);
-  std::vector<double> nearestD2(1);
+  std::vector<Index> nearest(8);
+  std::vector<double> nearestD2(8);
   for (Index i = begin; i < end; ++i)
   {
     double* x = &state.Position[3 * i];
     double* v = &state.Velocity[3 * i];
     SPHWallClamp(x, v, this->Physics);
-    if (obstacles && this->NearObstacle(x) && this->ObstacleGrid.FindKNearest(x, 1, nearest, nearestD2) == 1)
+    double depth = 0.0;
+    const Index sample = obstacles && this->NearObstacle(x) ? this->ObstacleSample(x, nearest, nearestD2, depth) : -1;
+    if (sample >= 0)
     {
-      const double* s = &this->ObstaclePosition[3 * nearest[0]];
-      const double* nrm = &this->ObstacleNormal[3 * nearest[0]];
-      const double depth = (x[0] - s[0]) * nrm[0] + (x[1] - s[1]) * nrm[1] + (x[2] - s[2]) * nrm[2];
+      const double* nrm = &this->ObstacleNormal[3 * sample];
       if (depth < this->WallMargin)
       {
         const double push = this->WallMargin - depth;

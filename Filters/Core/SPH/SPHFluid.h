@@ -259,6 +259,11 @@ private:
   void Enforce(SPHState& state, Index begin, Index end) const;
   bool NearBoundary(const double* x) const;
   bool NearObstacle(const double* x) const;
+  /// The obstacle sample whose tangent plane decides whether x is inside an obstacle: among the samples nearest
+  /// to x (all those equally near, up to 8: at an edge or corner samples of several faces tie, some at the same
+  /// position), the one that puts x farthest outside (largest (x - s) . n, in `depth`). It depends on the positions
+  /// and normals only, never on the order of the samples (of the obstacle's triangles). -1 when there is none.
+  Index ObstacleSample(const double* x, std::vector<Index>& ids, std::vector<double>& d2, double& depth) const;
   void FillConstants(); // Physics from the members below, at the end of Setup()
 
   SPHParameters Params;

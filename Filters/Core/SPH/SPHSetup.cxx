@@ -433,12 +433,13 @@ SPHState SPHFluid::InitialState()
     this->WarningList.push_back("FluidBounds hold no lattice node of ParticleSpacing: the fluid has no particles");
   }
   Index outside = 0;
-  std::vector<Index> nearest(1);
-  std::vector<double> nearestD2(1);
+  std::vector<Index> nearest(8);
+  std::vector<double> nearestD2(8);
   // A node outside the obstacles' bounding box cannot be inside one: only nodes within 10 spacings of that box take
-  // the nearest-sample normal test, whose answer far from an obstacle can depend on ties between coincident samples
-  // (edges, corners), i.e. on the order of the triangles. Within the 10 spacings the test is unchanged (it also drops
-  // some nodes in the plane of a face just beyond an edge, which the validated obstacle results include).
+  // the nearest-sample normal test (ObstacleSample: ties between samples of several faces, at edges and corners, go
+  // to the plane that puts the node farthest outside, whatever the order of the triangles). Within the 10 spacings
+  // the test drops some nodes in the plane of a face just beyond an edge, which the validated obstacle results
+  // include.
   double obstacleBox[6] = { 0.0, -1.0, 0.0, -1.0, 0.0, -1.0 };
   const double grow = 10.0 * dx;
   for (std::size_t q = 0; q < this->ObstaclePosition.size(); q += 3)
@@ -472,12 +473,11 @@ SPHState SPHFluid::InitialState()
             keep = false;
           }
         }
+        double depth = 0.0;
         if (keep && !this->ObstaclePosition.empty() && nearObstacles(x) &&
-          this->ObstacleGrid.FindKNearest(x, 1, nearest, nearestD2) == 1)
+          this->ObstacleSample(x, nearest, nearestD2, depth) >= 0)
         {
-          const double* s = &this->ObstaclePosition[3 * nearest[0]];
-          const double* n = &this->ObstacleNormal[3 * nearest[0]];
-          keep = (x[0] - s[0]) * n[0] + (x[1] - s[1]) * n[1] + (x[2] - s[2]) * n[2] > 0.5 * dx;
+          keep = depth > 0.5 * dx;
         }
         if (!keep)
         {
