@@ -125,6 +125,17 @@ void CheckGrid(const Cloud& c, const std::vector<Index>& perm, double spacing, c
   {
     ASSERT_EQ(perm[other.SortedOrder()[s]], one.SortedOrder()[s]) << what << " sorted position " << s;
   }
+  Index dims[3];
+  one.GetGridDimensions(dims);
+  for (Index cell = 0; cell < dims[0] * dims[1] * dims[2]; ++cell) // each cell's points by (x, y, z)
+  {
+    for (Index s = one.Cells()[cell].Begin + 1; s < one.Cells()[cell].End; ++s)
+    {
+      ASSERT_TRUE(GridPointBefore(one.SortedPoints() + 3 * (s - 1), one.SortedOrder()[s - 1], one.SortedPoints() + 3 * s,
+        one.SortedOrder()[s]))
+        << what << " cell " << cell;
+    }
+  }
   auto mapped = [&](std::vector<Index> ids) {
     for (Index& id : ids)
     {

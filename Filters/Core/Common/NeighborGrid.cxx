@@ -155,6 +155,46 @@ void SortCellByPosition(double* xyz, Index* order, Index begin, Index end, std::
     }
     return;
   }
+  // Usually the x coordinates of a cell's points differ: then each point's rank is the number of smaller x, counted
+  // without branches (a comparison sort's branches mispredict on such keys), and the points move once.
+  const int count = static_cast<int>(end - begin);
+  double xs[24];
+  int rank[24];
+  for (int i = 0; i < count; ++i)
+  {
+    xs[i] = xyz[3 * (begin + i)];
+  }
+  bool distinct = true, sorted = true;
+  for (int i = 0; i < count; ++i)
+  {
+    int smaller = 0, equal = 0;
+    for (int j = 0; j < count; ++j)
+    {
+      smaller += xs[j] < xs[i] ? 1 : 0;
+      equal += xs[j] == xs[i] ? 1 : 0;
+    }
+    rank[i] = smaller;
+    distinct = distinct && equal == 1;
+    sorted = sorted && smaller == i;
+  }
+  if (distinct)
+  {
+    if (!sorted)
+    {
+      PointRecord moved[24];
+      for (int i = 0; i < count; ++i)
+      {
+        const Index s = begin + i;
+        moved[rank[i]] = { { xyz[3 * s], xyz[3 * s + 1], xyz[3 * s + 2] }, order[s] };
+      }
+      for (int i = 0; i < count; ++i)
+      {
+        std::copy(moved[i].first.begin(), moved[i].first.end(), xyz + 3 * (begin + i));
+        order[begin + i] = moved[i].second;
+      }
+    }
+    return;
+  }
   for (Index s = begin + 1; s < end; ++s) // insertion sort
   {
     const double p[3] = { xyz[3 * s], xyz[3 * s + 1], xyz[3 * s + 2] };
