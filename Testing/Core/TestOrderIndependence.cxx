@@ -131,8 +131,8 @@ void CheckGrid(const Cloud& c, const std::vector<Index>& perm, double spacing, c
   {
     for (Index s = one.Cells()[cell].Begin + 1; s < one.Cells()[cell].End; ++s)
     {
-      ASSERT_TRUE(GridPointBefore(one.SortedPoints() + 3 * (s - 1), one.SortedOrder()[s - 1], one.SortedPoints() + 3 * s,
-        one.SortedOrder()[s]))
+      const double* xyz = one.SortedPoints();
+      ASSERT_TRUE(GridPointBefore(xyz + 3 * (s - 1), one.SortedOrder()[s - 1], xyz + 3 * s, one.SortedOrder()[s]))
         << what << " cell " << cell;
     }
   }

@@ -3,11 +3,12 @@
 // NeighborGrid::ChooseCells for the bounds, cell keys from NeighborGrid::MortonTables and GridAxisCell, a stable
 // sort of (key, index) (the device's CUB radix sort is stable), cell ranges from runs of equal keys; and the
 // neighbour walk GridForEachCandidate (Common/GridCell.h, the function the kernels call). They must reproduce
-// NeighborGrid's SortedOrder() and Cells() (the solver's grid, SetCellsByPosition(false)), and list every point's neighbours within h in the order of
-// FindWithinRadiusForAllPoints' rows (fluid) and of FindWithinRadius (arbitrary positions, the wall dummies'
-// queries), so that the device's sums add the same terms in the same order as the CPU's. Then the kernels'
-// per-thread functions (SPH/SPHGridPasses.h) run over such a grid in host loops must give SPHFluid's density,
-// pressure and accelerations bit for bit (dam breaks in motion, 2D and 3D, Ideal and Tait, every force term).
+// NeighborGrid's SortedOrder() and Cells() (the solver's grid, SetCellsByPosition(false)), and list every point's
+// neighbours within h in the order of FindWithinRadiusForAllPoints' rows (fluid) and of FindWithinRadius
+// (arbitrary positions, the wall dummies' queries), so that the device's sums add the same terms in the same order
+// as the CPU's. Then the kernels' per-thread functions (SPH/SPHGridPasses.h) run over such a grid in host loops must
+// give SPHFluid's density, pressure and accelerations bit for bit (dam breaks in motion, 2D and 3D, Ideal and
+// Tait, every force term).
 #include "Common/GridCell.h"
 #include "Common/GridCellView.h"
 #include "Common/NeighborGrid.h"

@@ -4,8 +4,9 @@
 // (Testing/Core/TestMLSDevicePoint.cxx) although no GPU is at hand. It reproduces Approximator::MLSShape/MLSPoint
 // for the case the fast path finishes: the k nearest in NeighborGrid's neighbour order (d2, then position, then
 // original index: GridNeighborBefore) found in its cell-sorted layout (rings of cells around the query's cell,
-// pruned by the k-th distance), h = SupportFactor x d_k, the neighbours in that order, the plain weights of KernelShapes.h, the moment solve of MLSFastPath.h, values and
-// gradients summed in the CPU's order. Anything else returns false: the caller hands the point to the CPU.
+// pruned by the k-th distance), h = SupportFactor x d_k, the neighbours in that order, the plain weights of
+// KernelShapes.h, the moment solve of MLSFastPath.h, values and gradients summed in the CPU's order. Anything else
+// returns false: the caller hands the point to the CPU.
 #ifndef meshfree_MLSDevicePoint_h
 #define meshfree_MLSDevicePoint_h
 

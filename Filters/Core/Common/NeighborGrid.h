@@ -176,8 +176,8 @@ public:
   Index CountWithinRadius(const double x[3], double radius) const;
 
   /// The k nearest valid points to x (all valid points when there are fewer than k), the first in the
-  /// neighbour order (NeighborBefore()) and sorted that way. ids and dist2 must hold min(k, NumberOfValidPoints()) entries.
-  /// Returns the number found.
+  /// neighbour order (NeighborBefore()) and sorted that way. ids and dist2 must hold min(k,
+  /// NumberOfValidPoints()) entries. Returns the number found.
   int FindKNearest(const double x[3], int k, Index* ids, double* dist2) const;
   /// As above; ids and dist2 are resized to the number found (their capacity is kept).
   int FindKNearest(const double x[3], int k, std::vector<Index>& ids, std::vector<double>& dist2) const;
