@@ -25,6 +25,12 @@
  *   (Mass and Density arrays) and otherwise V_j = 1 / sum_k W(|x_j - x_k|, h_j) (the inverse number
  *   density); optional Shepard normalisation divides by sum_j V_j W. The kernel is normalised in the
  *   cloud's dimension.
+ * - RBF (ApproximationRBF.h): interpolation by a polyharmonic spline with a polynomial tail (r^2 log r in 2D,
+ *   r^3 in 1D and 3D; TailDegree 1), SciPy's RBFInterpolator defaults, with its Smoothing: one global fit up to
+ *   RBFGlobalLimit valid points (a dense solve), above it RBF-PU, local RBF fits on the PU-WLS lattice blended
+ *   by the partition of unity. Coincident points are merged (mean value); Report().MethodUsed says which ran.
+ * - Auto: resolved by SetCloud from the number of valid points (over every part), the dimension and Smoothing
+ *   (see ResolveAuto in ApproximationRBF.cxx); Report().MethodUsed and MethodReason say what and why.
  *
  * Support radius: with SupportRadius <= 0, h = SupportFactor * (distance to the NeighborCount-th nearest
  * point) at each evaluation point, so that exactly NeighborCount points carry weight (SupportFactor = 1.1);
@@ -114,7 +120,7 @@ struct ApproximationOptions
   // (larger ones: RBF-PU) and the points per RBF-PU patch (0: kRBFPatchPoints for the cloud's dimension).
   double Smoothing = 0.0;
   int TailDegree = 1;
-  Index RBFGlobalLimit = 2000;
+  Index RBFGlobalLimit = 1000;
   int PatchPoints = 0;
 };
 

@@ -185,7 +185,7 @@ void EvaluatePolyharmonic(int D, int beta, const PolyharmonicFit& fit, const dou
       {
         const double dx = xi[0] - X[3 * j], dy = xi[1] - X[3 * j + 1];
         const double r2 = dx * dx + dy * dy;
-        sum += r2 > 0.0 ? 0.5 * r2 * std::log(r2) * W[j] : 0.0;
+        sum += 0.5 * r2 * KernelLog(r2 > 1e-300 ? r2 : 1.0) * W[j];
       }
     }
     else

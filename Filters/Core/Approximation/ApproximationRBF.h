@@ -34,6 +34,9 @@
 
 #include "Approximation/Approximation.h"
 
+#include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 namespace meshfree
@@ -74,24 +77,61 @@ struct Approximator::RBFData
   std::vector<double> Values;
 };
 
-/// phi(r) from r^2 for beta = 2 (r^2 log r = r^2 log(r^2) / 2) and 3 (r^3).
-inline double PolyharmonicValue(int beta, double r2)
+/**
+ * log(x) for positive, finite, normal x, to a few units in the last place, without branches or calls (so that
+ * the evaluation loops vectorise; std::log is a call per kernel value): x = 2^e m with m in [sqrt(1/2),
+ * sqrt(2)), log m = 2 atanh(s) = 2 (s + s^3/3 + s^5/5 + ...), s = (m - 1) / (m + 1), |s| < 0.172, the series
+ * summed to s^23 (the next term is below 1e-18 of the sum). Zero gives a finite value (-745...), which the
+ * callers multiply by r^2 = 0.
+ */
+inline double KernelLog(double x)
 {
-  if (!(r2 > 0.0))
-  {
-    return 0.0;
-  }
-  return beta == 2 ? 0.5 * r2 * std::log(r2) : r2 * std::sqrt(r2);
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  // The exponent as a double without an integer conversion: 2^52 + e_biased, minus 2^52 + 1023.
+  std::uint64_t exponentBits = 0x4330000000000000ULL | (bits >> 52);
+  double e;
+  std::memcpy(&e, &exponentBits, sizeof e);
+  e -= 4503599627370496.0 + 1023.0;
+  std::uint64_t mantissaBits = (bits & 0x000FFFFFFFFFFFFFULL) | 0x3FF0000000000000ULL;
+  double m;
+  std::memcpy(&m, &mantissaBits, sizeof m);
+  const bool high = m > 1.4142135623730951;
+  m = high ? 0.5 * m : m;
+  e = high ? e + 1.0 : e;
+  const double s = (m - 1.0) / (m + 1.0);
+  const double z = s * s;
+  double p = 1.0 / 23.0;
+  p = p * z + 1.0 / 21.0;
+  p = p * z + 1.0 / 19.0;
+  p = p * z + 1.0 / 17.0;
+  p = p * z + 1.0 / 15.0;
+  p = p * z + 1.0 / 13.0;
+  p = p * z + 1.0 / 11.0;
+  p = p * z + 1.0 / 9.0;
+  p = p * z + 1.0 / 7.0;
+  p = p * z + 1.0 / 5.0;
+  p = p * z + 1.0 / 3.0;
+  p = p * z + 1.0;
+  return e * 0.69314718055994530942 + 2.0 * s * p;
 }
 
-/// phi'(r) / r (the gradient is this times xi - xi_j): log(r^2) + 1 for beta = 2, 3 r for beta = 3.
+/// phi(r) from r^2 for beta = 2 (r^2 log r = r^2 log(r^2) / 2) and 3 (r^3); 0 at r = 0.
+inline double PolyharmonicValue(int beta, double r2)
+{
+  const double r2safe = r2 > 1e-300 ? r2 : 1.0; // log(1) = 0: phi(0) = 0 (and subnormal r^2 counts as 0)
+  return beta == 2 ? 0.5 * r2 * KernelLog(r2safe) : r2 * std::sqrt(r2);
+}
+
+/// phi'(r) / r (the gradient is this times xi - xi_j): log(r^2) + 1 for beta = 2, 3 r for beta = 3; 0 at r = 0
+/// (where xi - xi_j = 0).
 inline double PolyharmonicSlope(int beta, double r2)
 {
-  if (!(r2 > 0.0))
+  if (!(r2 > 1e-300))
   {
     return 0.0;
   }
-  return beta == 2 ? std::log(r2) + 1.0 : 3.0 * std::sqrt(r2);
+  return beta == 2 ? KernelLog(r2) + 1.0 : 3.0 * std::sqrt(r2);
 }
 
 /**
