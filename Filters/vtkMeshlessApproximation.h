@@ -17,8 +17,10 @@
  * kernel sum), RBF (radial basis function interpolation: a polyharmonic spline - thin-plate r^2 log r in 2D, r^3
  * in 1D and 3D - with a linear polynomial tail, SciPy's RBFInterpolator defaults; one global fit up to
  * RBFGlobalLimit valid points, above it a partition of unity of local RBF fits on the PU-WLS lattice, RBF-PU;
- * Smoothing > 0 makes it a smoothing spline, with SciPy's `smoothing` meaning), Auto (picks one of these by the
- * cloud's size and Smoothing; see Filters/Core/Approximation/ApproximationRBF.cxx, ResolveAuto). BasisDegree 0-3
+ * Smoothing > 0 makes it a smoothing spline, with SciPy's `smoothing` meaning), Auto (a measured choice: 2D
+ * clouds up to 200 points the global thin-plate spline, larger ones PU-WLS of degree 3; 1D and 3D clouds RBF;
+ * with Smoothing > 0 the smoothing spline up to RBFGlobalLimit points, MLS above; see ResolveAuto in
+ * Filters/Core/Approximation/ApproximationRBF.cxx). BasisDegree 0-3
  * in the cloud's own dimension (not used by RBF, whose tail is linear). WeightFunction: a meshfree::KernelType
  * (for RBF-PU, the blending weight of the partition of unity). With RBF or Auto the output's field data hold
  * `ApproximationMethod` (what ran, e.g. "RBF (global)", "RBF-PU", "PU-WLS degree 3") and
@@ -153,7 +155,7 @@ public:
 
   ///@{
   /// RBF: the largest number of valid input points solved as one global fit (a dense O(N^3) solve; default
-  /// 1000); larger clouds use RBF-PU. Auto: below it Auto picks the global RBF.
+  /// 1000); larger clouds use RBF-PU.
   vtkSetClampMacro(RBFGlobalLimit, int, 0, 20000);
   vtkGetMacro(RBFGlobalLimit, int);
   ///@}

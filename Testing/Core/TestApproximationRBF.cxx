@@ -492,9 +492,18 @@ TEST(RBF, IndependentOfThePointsOrder)
 
 TEST(RBF, AutoSaysWhatItChoseAndWhy)
 {
-  for (int n : { 100, 3000 })
+  // 2D: the thin-plate spline for small clouds, PU-WLS of degree 3 above kAutoRBFPoints2D (200); 3D: r^3, global
+  // up to RBFGlobalLimit, RBF-PU above.
+  const struct
   {
-    const std::vector<double> xyz = Cloud(n, 2);
+    int N, Dim;
+    const char* Expected;
+  } cases[] = { { 100, 2, "RBF (global)" }, { 3000, 2, "PU-WLS degree 3" }, { 300, 3, "RBF (global)" },
+    { 1500, 3, "RBF-PU" } };
+  for (const auto& c : cases)
+  {
+    const int n = c.N;
+    const std::vector<double> xyz = Cloud(n, c.Dim);
     std::vector<double> values(n);
     for (int i = 0; i < n; ++i)
       values[i] = Franke(xyz[3 * i], xyz[3 * i + 1]);
@@ -503,9 +512,9 @@ TEST(RBF, AutoSaysWhatItChoseAndWhy)
     Approximator approx;
     ASSERT_TRUE(approx.SetOptions(opts));
     ASSERT_TRUE(approx.SetCloud(xyz.data(), n, values.data(), 1));
-    EXPECT_EQ(approx.Report().MethodUsed, n <= opts.RBFGlobalLimit ? "RBF (global)" : "PU-WLS degree 3");
-    EXPECT_FALSE(approx.Report().MethodReason.empty());
-    const Result r = EvaluateAll(approx, Cloud(100, 2, 0.1, 0.8, 4000));
+    EXPECT_EQ(approx.Report().MethodUsed, c.Expected) << approx.Report().MethodReason;
+    EXPECT_NE(approx.Report().MethodReason.find(std::to_string(n)), std::string::npos);
+    const Result r = EvaluateAll(approx, Cloud(100, c.Dim, 0.1, 0.8, 4000));
     ExpectFinite(r);
     for (int i = 0; i < 100; ++i)
       EXPECT_EQ(r.Valid[i], 1);
