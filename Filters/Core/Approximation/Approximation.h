@@ -302,6 +302,7 @@ private:
   bool RBFIsGlobal() const;
   int PatchSize() const;
   bool PrepareRBF(const double* xyz, Index m);
+  bool PrepareRBFFits(const double* xyz, Index m);
   PointResult RBFPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   /// The k nearest points of x (radius <= 0; h = SupportFactor x the k-th distance) or those within radius
   /// (h = radius), in s.Ids / s.Dist2 ordered by index: the fits' sums then do not depend on how the

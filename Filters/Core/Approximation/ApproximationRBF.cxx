@@ -11,6 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <new>
+#include <string>
 #include <limits>
 #include <numeric>
 
@@ -338,6 +341,28 @@ int KernelBeta(int dimension)
 } // namespace
 
 bool Approximator::PrepareRBF(const double* xyz, Index count)
+{
+  // The dense systems are allocated here (N^2 doubles for the global fit): running out of memory is an error
+  // with a message, not a crash.
+  try
+  {
+    return this->PrepareRBFFits(xyz, count);
+  }
+  catch (const std::bad_alloc&)
+  {
+    this->RBFFits.reset();
+    this->Err = "not enough memory for the RBF systems (" + std::to_string(this->GlobalValidPoints) +
+      " points; lower RBFGlobalLimit to use RBF-PU)";
+  }
+  catch (const std::exception& e)
+  {
+    this->RBFFits.reset();
+    this->Err = std::string("the RBF fit failed: ") + e.what();
+  }
+  return false;
+}
+
+bool Approximator::PrepareRBFFits(const double* xyz, Index count)
 {
   this->RBFFits.reset(new RBFData);
   RBFData& rbf = *this->RBFFits;
