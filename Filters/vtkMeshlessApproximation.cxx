@@ -516,6 +516,8 @@ int vtkMeshlessApproximation::RequestData(
   opts.Diagnostics = this->Diagnostics;
   opts.NullValue = this->NullValue;
   opts.Backend = static_cast<meshfree::ApproximationBackend>(this->Backend);
+  opts.Smoothing = this->Smoothing;
+  opts.RBFGlobalLimit = this->RBFGlobalLimit;
   if (!std::isfinite(this->NullValue))
   {
     vtkWarningMacro("NullValue " << this->NullValue << " is not a finite number: masked points get 0 instead.");
@@ -545,7 +547,8 @@ int vtkMeshlessApproximation::RequestData(
                        "they are ignored.");
   }
   const vtkIdType valid = globalN - excluded;
-  if (valid > 0 && this->SupportRadius <= 0 && this->NeighborCount > valid && this->Method != LS)
+  if (valid > 0 && this->SupportRadius <= 0 && this->NeighborCount > valid && this->Method != LS &&
+    this->Method != RBF && this->Method != AUTO)
   {
     vtkWarningMacro("NeighborCount (" << this->NeighborCount << ") exceeds the " << valid
                                       << " valid input points: all of them are used.");
@@ -760,6 +763,18 @@ int vtkMeshlessApproximation::RequestData(
                     << " output points could not be evaluated (no input point within the support, or a "
                        "degenerate fit after every fallback): they get NullValue and vtkValidPointMask = 0.");
   }
+  if (report.MergedPoints > 0 && (!controller || controller->GetLocalProcessId() == 0))
+  {
+    vtkWarningMacro(<< report.MergedPoints
+                    << " input points coincide with others (closer than 1e-10 of the cloud's diameter): RBF "
+                       "merged each group into one point with the mean of their values.");
+  }
+  if (report.Regularized > 0)
+  {
+    vtkWarningMacro(<< report.Regularized
+                    << " RBF fit(s) were singular or ill-conditioned (condition estimate above 1e14): solved in the "
+                       "least-squares sense (near-duplicate points?); the result may not interpolate there.");
+  }
   if (report.Widened + report.DegreeLowered > 0)
   {
     vtkDebugMacro(<< report.Widened << " points needed a wider support, " << report.DegreeLowered
@@ -865,6 +880,17 @@ int vtkMeshlessApproximation::RequestData(
   {
     outPD->SetActiveScalars(selected.front().Name.c_str());
   }
+  if (!report.MethodUsed.empty() && (this->Method == RBF || this->Method == AUTO))
+  {
+    vtkNew<vtkStringArray> chosen;
+    chosen->SetName("ApproximationMethod");
+    chosen->InsertNextValue(report.MethodUsed);
+    output->GetFieldData()->AddArray(chosen);
+    vtkNew<vtkStringArray> reason;
+    reason->SetName("ApproximationMethodReason");
+    reason->InsertNextValue(report.MethodReason);
+    output->GetFieldData()->AddArray(reason);
+  }
   vtkNew<vtkStringArray> ran;
   ran->SetName("Backend");
   ran->InsertNextValue(report.Backend);
@@ -893,6 +919,8 @@ void vtkMeshlessApproximation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "HeightField: " << this->HeightField << "\n";
   os << indent << "ShepardNormalization: " << this->ShepardNormalization << "\n";
   os << indent << "NullValue: " << this->NullValue << "\n";
+  os << indent << "Smoothing: " << this->Smoothing << "\n";
+  os << indent << "RBFGlobalLimit: " << this->RBFGlobalLimit << "\n";
   os << indent << "Backend: " << this->Backend << "\n";
   os << indent << "ModelBounds: " << this->ModelBounds[0] << ", " << this->ModelBounds[1] << ", "
      << this->ModelBounds[2] << ", " << this->ModelBounds[3] << ", " << this->ModelBounds[4] << ", "

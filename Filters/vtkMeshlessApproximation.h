@@ -1,6 +1,6 @@
 /**
  * @class   vtkMeshlessApproximation
- * @brief   LS, WLS, MLS, PU-WLS and SPH approximation of a point cloud's arrays (ParaView "Meshless Approximation")
+ * @brief   LS, WLS, MLS, PU-WLS, SPH and RBF approximation of a point cloud's arrays (ParaView "Meshless Approximation")
  *
  * Input port 0 (`Input`) is a point cloud (vtkPointSet): every numeric point array, every component, is
  * approximated (or only those named with AddPointArray()). Optional port 1 (`Probe`, any vtkDataSet): the
@@ -14,7 +14,17 @@
  * around Center, valid near it), MLS (the fit re-centred at every output point; default), PU-WLS (local fits
  * at lattice centres blended by a partition of unity), SPH (sum_j A_j m_j/rho_j W, with volumes from the
  * `Mass` and `Density` arrays when both exist, otherwise estimated; ShepardNormalization divides by the
- * kernel sum). BasisDegree 0-3 in the cloud's own dimension. WeightFunction: a meshfree::KernelType.
+ * kernel sum), RBF (radial basis function interpolation: a polyharmonic spline - thin-plate r^2 log r in 2D, r^3
+ * in 1D and 3D - with a linear polynomial tail, SciPy's RBFInterpolator defaults; one global fit up to
+ * RBFGlobalLimit valid points, above it a partition of unity of local RBF fits on the PU-WLS lattice, RBF-PU;
+ * Smoothing > 0 makes it a smoothing spline, with SciPy's `smoothing` meaning), Auto (a measured choice: 2D
+ * clouds up to 200 points the global thin-plate spline, larger ones PU-WLS of degree 3; 1D and 3D clouds RBF;
+ * with Smoothing > 0 the smoothing spline up to RBFGlobalLimit points, MLS above; see ResolveAuto in
+ * Filters/Core/Approximation/ApproximationRBF.cxx). BasisDegree 0-3
+ * in the cloud's own dimension (not used by RBF, whose tail is linear). WeightFunction: a meshfree::KernelType
+ * (for RBF-PU, the blending weight of the partition of unity). With RBF or Auto the output's field data hold
+ * `ApproximationMethod` (what ran, e.g. "RBF (global)", "RBF-PU", "PU-WLS degree 3") and
+ * `ApproximationMethodReason` (why).
  *
  * Support: the NeighborCount nearest points of each output point carry weight (h = 1.1 x distance to the
  * NeighborCount-th one), unless SupportRadius > 0 fixes h. Fallbacks for a degenerate fit: twice the
@@ -65,15 +75,17 @@ public:
     WLS = 1,
     MLS = 2,
     PU_WLS = 3,
-    SPH = 4
+    SPH = 4,
+    RBF = 5,
+    AUTO = 6
   };
 
   /// The probe (optional port 1).
   void SetProbeConnection(vtkAlgorithmOutput* output);
 
   ///@{
-  /// Approximation method, LS / WLS / MLS (default) / PU-WLS / SPH.
-  vtkSetClampMacro(Method, int, LS, SPH);
+  /// Approximation method, LS / WLS / MLS (default) / PU-WLS / SPH / RBF / Auto.
+  vtkSetClampMacro(Method, int, LS, AUTO);
   vtkGetMacro(Method, int);
   ///@}
 
@@ -131,6 +143,21 @@ public:
   vtkSetMacro(ShepardNormalization, bool);
   vtkGetMacro(ShepardNormalization, bool);
   vtkBooleanMacro(ShepardNormalization, bool);
+  ///@}
+
+  ///@{
+  /// RBF: lambda added to the kernel matrix's diagonal, the kernel in data units (SciPy's RBFInterpolator
+  /// `smoothing`); 0 (default) interpolates the data, larger values smooth noisy data (towards the linear
+  /// least-squares fit as it grows). Auto: > 0 says the data are noisy.
+  vtkSetClampMacro(Smoothing, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(Smoothing, double);
+  ///@}
+
+  ///@{
+  /// RBF: the largest number of valid input points solved as one global fit (a dense O(N^3) solve; default
+  /// 1000); larger clouds use RBF-PU.
+  vtkSetClampMacro(RBFGlobalLimit, int, 0, 20000);
+  vtkGetMacro(RBFGlobalLimit, int);
   ///@}
 
   ///@{
@@ -209,6 +236,8 @@ protected:
   bool HeightField = false;
   bool ShepardNormalization = true;
   double NullValue = 0.0;
+  double Smoothing = 0.0;
+  int RBFGlobalLimit = 1000;
   int Backend = BACKEND_AUTO;
   double ModelBounds[6] = { 0, 0, 0, 0, 0, 0 };
   int SampleDimensions[3] = { 101, 101, 101 };

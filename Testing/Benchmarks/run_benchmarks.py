@@ -8,7 +8,9 @@ The plugin comes from $MESHFREE_PLUGIN, else from <source>/build. --out defaults
 <build>/benchmark-results. --only takes a comma list of approximation,sph,solid (default: all three).
 --threads N puts every tool on N threads (default: all cores; on a machine shared with other work, --threads 1
 gives a fair comparison, since OpenMP and other fork-join pools wait for descheduled threads at every barrier).
-Writes approximation.csv, sph.csv, solid.csv, pareto.md and the PNGs (bench_report.py draws them).
+Writes approximation.csv, sph.csv, solid.csv, pareto.md and the PNGs (bench_report.py draws them), and
+wins_losses.md: per field and N, the peers both faster and more accurate than MeshFree's most accurate setting.
+Issue 26's table: --quick --sizes 100,300,1000,3000,10000 --rbf-global-limit 3000 --only approximation.
 
 approximation.csv  method,peer,n,degree,rms_error,max_error,seconds,evals_per_second
   method   "<field>/<method and its settings>". Fields: F1..F10 are Renka & Brown's ten bivariate test functions
@@ -17,7 +19,9 @@ approximation.csv  method,peer,n,degree,rms_error,max_error,seconds,evals_per_se
            in [0,1]^3. Settings: k = neighbours, r<c>h = radius c x the mean spacing h = N^(-1/dim),
            n = N closest points, p = Shepard power, s = Gaussian sharpness, step<c>h = SPH smoothing length.
   peer     0 for MeshFree's MeshlessApproximation filter (every method and degree, Wendland weight, 20
-           neighbours: the filter's defaults), 1 for other tools, measured in the same process:
+           neighbours: the filter's defaults; RBF as rbf_tps (2D) / rbf_r3 (3D) at its default RBFGlobalLimit
+           1,000 - global below, RBF-PU above -, rbf_global forced global up to --rbf-global-limit, rbf_pu forced
+           RBF-PU, and auto), 1 for other tools, measured in the same process:
              vtk_*    VTK's vtkPointInterpolator with the Gaussian, Shepard, Linear and Voronoi kernels and
                       vtkSPHInterpolator with the quintic, cubic, quartic and Wendland quintic SPH kernels
                       (Shepard-normalised), VTK_SMP_BACKEND_IN_USE=STDThread;
@@ -275,16 +279,24 @@ class Method:
         self.prepare = prepare or (lambda problem: None)
 
 
-def meshfree_methods(filt, proxy, dim):
+RBF_GLOBAL_DEFAULT = 1000  # the filter's default RBFGlobalLimit
+
+
+def meshfree_methods(filt, proxy, dim, n=0, rbf_global_limit=3000):
     """Every method and degree at the filter's defaults (Wendland, 20 neighbours); in 3D, degree 3 (20 basis
-    functions, as many as the default neighbours) also with 40 neighbours."""
+    functions, as many as the default neighbours) also with 40 neighbours. RBF at its default (global up to
+    RBFGlobalLimit = 1,000 points, RBF-PU above), forced global (up to rbf_global_limit points) and forced
+    RBF-PU; Auto."""
     out = []
 
-    def make(method, degree, k):
+    def make(method, degree, k, limit=RBF_GLOBAL_DEFAULT):
         def prepare(problem):
             proxy.Method = method  # pushed to the VTK object at once
             proxy.BasisDegree = degree
             proxy.NeighborCount = k
+            if proxy.GetProperty("RBFGlobalLimit") is not None:
+                proxy.RBFGlobalLimit = limit
+                proxy.Smoothing = 0.0
             filt.SetInputDataObject(0, problem.cloud)
             filt.SetInputDataObject(1, problem.probe)
 
@@ -300,6 +312,13 @@ def meshfree_methods(filt, proxy, dim):
             if dim == 3 and degree == 3 and method in ("MLS", "PU-WLS"):
                 out.append(Method("%s_wendland_k40" % method.lower(), 0, degree, *make(method, degree, 40)))
     out.append(Method("sph_wendland_k20", 0, 0, *make("SPH", 2, 20)))
+    if proxy.GetProperty("RBFGlobalLimit") is not None:
+        out.append(Method("rbf_tps" if dim == 2 else "rbf_r3", 0, 1, *make("RBF", 2, 20)))
+        if RBF_GLOBAL_DEFAULT < n <= rbf_global_limit:
+            out.append(Method("rbf_global", 0, 1, *make("RBF", 2, 20, 20000)))
+        if n <= RBF_GLOBAL_DEFAULT:
+            out.append(Method("rbf_pu", 0, 1, *make("RBF", 2, 20, 0)))
+        out.append(Method("auto", 0, 2, *make("Auto", 2, 20)))
     return out
 
 
@@ -436,7 +455,7 @@ def run_approximation(cfg):
         first = problem.names[0]
         log("\n=== %dD, N = %d, %d evaluation points, fields %s (setup %.1f s)" % (
             dim, n, len(problem.eval), ",".join(problem.names), time.perf_counter() - t0))
-        chosen = list(meshfree_methods(filt, proxy, dim))
+        chosen = list(meshfree_methods(filt, proxy, dim, n, cfg.rbf_global_limit))
         families = dict(vtk_peer_families(dim))
         families.update(scipy_peer_families(dim, n, cfg.rbf_global_limit))
         problem.set_fields([first])
@@ -475,6 +494,49 @@ def run_approximation(cfg):
     simple.Delete(proxy)
     simple.Delete(sphere)
     return rows
+
+
+# ---------------------------------------------------------------------------------------------- wins and losses
+ACCURACY_MARGIN = 0.01  # "more accurate": an rms error lower by more than 1% (identical methods tie)
+
+
+def wins_losses(rows):
+    """Markdown: for every field and N, MeshFree's most accurate setting (lowest rms error) and the peers that
+    are both faster and more accurate than it (a peer win), then Auto against that best setting. Rows of one
+    run (same process, same evaluation points)."""
+    groups = {}
+    for r in rows:
+        field, _, name = r["method"].partition("/")
+        groups.setdefault((field, int(r["n"])), []).append((name, r))
+    lines = ["| field | N | MeshFree's most accurate setting: rms, s | peers faster and more accurate (rms, s) | "
+             "most accurate peer: rms, s | Auto: rms, s (x best's rms, x best's time) |",
+             "|---|---|---|---|---|---|"]
+    wins = total = 0
+    for (field, n) in sorted(groups, key=lambda k: (k[0].endswith("_3d"), len(k[0]), k[0], k[1])):
+        rs = groups[(field, n)]
+        ours = [(name, r) for name, r in rs if r["peer"] == 0 and math.isfinite(r["rms_error"])]
+        peers = [(name, r) for name, r in rs if r["peer"] == 1 and math.isfinite(r["rms_error"])]
+        if not ours:
+            continue
+        bname, best = min(ours, key=lambda q: q[1]["rms_error"])
+        beating = [(name, r) for name, r in peers
+                   if r["seconds"] < best["seconds"] and r["rms_error"] < (1 - ACCURACY_MARGIN) * best["rms_error"]]
+        total += 1
+        wins += 1 if beating else 0
+        pname, pbest = min(peers, key=lambda q: q[1]["rms_error"]) if peers else ("-", None)
+        auto = [r for name, r in ours if name == "auto"]
+        auto_text = "-"
+        if auto:
+            a = auto[0]
+            auto_text = "%.2g, %.3g (%.2fx, %.2fx)" % (a["rms_error"], a["seconds"], a["rms_error"] / best["rms_error"],
+                                                       a["seconds"] / best["seconds"])
+        lines.append("| %s | %d | %s d%d: %.2g, %.3g | %s | %s | %s |" % (
+            field, n, bname, best["degree"], best["rms_error"], best["seconds"],
+            "; ".join("**%s** (%.2g, %.3g)" % (name, r["rms_error"], r["seconds"]) for name, r in beating) or "none",
+            "%s: %.2g, %.3g" % (pname, pbest["rms_error"], pbest["seconds"]) if pbest else "-", auto_text))
+    head = ("Peer wins (a peer both faster and more accurate - rms lower by more than %d%% - than MeshFree's most "
+            "accurate setting at that field and N): %d of %d cases.\n\n" % (100 * ACCURACY_MARGIN, wins, total))
+    return head + "\n".join(lines) + "\n"
 
 
 # ---------------------------------------------------------------------------------------------- SPH
@@ -863,8 +925,15 @@ def main():
     start = time.perf_counter()
     load0 = " ".join("%.2f" % v for v in os.getloadavg())
     if "approximation" in parts:
+        approximation_rows = run_approximation(cfg)
         bench_report.write_csv(os.path.join(out, "approximation.csv"), bench_report.APPROXIMATION_COLUMNS,
-                               run_approximation(cfg))
+                               approximation_rows)
+        table = "# Wins and losses against the peers (generated by run_benchmarks.py)\n\nMachine: %s\n\n" \
+                "Command: `pvpython --no-mpi Testing/Benchmarks/run_benchmarks.py %s`\n\n%s" % (
+                    machine, " ".join(sys.argv[1:]), wins_losses(approximation_rows))
+        with open(os.path.join(out, "wins_losses.md"), "w") as f:
+            f.write(table)
+        log("\n" + table)
     if "sph" in parts:
         bench_report.write_csv(os.path.join(out, "sph.csv"), bench_report.SPH_COLUMNS, run_sph(cfg))
     if "solid" in parts:

@@ -169,7 +169,7 @@ def surface_rows(data):
     return np.column_stack([key, pts, mask])
 
 
-METHODS = ["LS", "WLS", "MLS", "PU-WLS", "SPH"]
+METHODS = ["LS", "WLS", "MLS", "PU-WLS", "SPH", "RBF"]  # RBF on 1,500-3,000 points: RBF-PU (the PU-WLS halo)
 SUPPORTS = {"k-nearest": dict(NeighborCount=20), "radius": dict(SupportRadius=0.2)}
 
 
@@ -211,6 +211,14 @@ def main():
                     mm.log(f"{label}: serial on a permuted cloud moves by {moved:.3g} of the range")
                 mm.check(np.array_equal(one[:, 1:], other[:, 1:]), f"{label}: serial on a permuted cloud differs")
                 results[label] = run_case(label, noids, method, support, None, serial_cloud=same)
+
+    # RBF as one global fit (600 points <= RBFGlobalLimit: every rank gathers the cloud) and Auto.
+    small_cloud = cloud_source("plain", 600, 19)
+    for method in ("RBF", "Auto"):
+        for output in ("grid", "probe"):
+            label = f"{method}, global, {output}"
+            results[label] = run_case(label, small_cloud, method, SUPPORTS["k-nearest"],
+                                      probe_source if output == "probe" else None)
 
     # SPH with Mass and Density (given volumes), and height fields.
     sph_cloud = cloud_source("sph", 2000, 3)

@@ -3,6 +3,7 @@
 // MLS. PU-WLS is in ApproximationPU.cxx, SPH in ApproximationSPH.cxx.
 #include "Approximation/Approximation.h"
 #include "Approximation/ApproximationPU.h"
+#include "Approximation/ApproximationRBF.h"
 #include "cuda/ApproximationDevice.h"
 
 #include <algorithm>
@@ -28,6 +29,10 @@ const char* ApproximationMethodName(ApproximationMethod method)
       return "PU-WLS";
     case ApproximationMethod::SPH:
       return "SPH";
+    case ApproximationMethod::RBF:
+      return "RBF";
+    case ApproximationMethod::Auto:
+      return "Auto";
   }
   return "Unknown";
 }
@@ -48,7 +53,8 @@ bool ApproximationMethodFromName(const std::string& name, ApproximationMethod& o
     ApproximationMethod Method;
   } table[] = { { "LS", ApproximationMethod::LS }, { "WLS", ApproximationMethod::WLS },
     { "MLS", ApproximationMethod::MLS }, { "PUWLS", ApproximationMethod::PUWLS },
-    { "SPH", ApproximationMethod::SPH } };
+    { "SPH", ApproximationMethod::SPH }, { "RBF", ApproximationMethod::RBF },
+    { "AUTO", ApproximationMethod::Auto } };
   for (const auto& entry : table)
   {
     if (upper == entry.Name)
@@ -85,7 +91,23 @@ bool Approximator::SetOptions(const ApproximationOptions& options)
     this->Err = "SupportFactor must be >= 1";
     return false;
   }
+  if (!(options.Smoothing >= 0.0) || !std::isfinite(options.Smoothing))
+  {
+    this->Err = "Smoothing must be finite and >= 0";
+    return false;
+  }
+  if (options.TailDegree < 0 || options.TailDegree > kMaxBasisDegree)
+  {
+    this->Err = "the RBF tail's degree must be 0..3";
+    return false;
+  }
+  if (options.RBFGlobalLimit < 0 || options.PatchPoints < 0)
+  {
+    this->Err = "RBFGlobalLimit and PatchPoints must be >= 0";
+    return false;
+  }
   this->Opts = options;
+  this->Requested = options.Method;
   if (!(this->Opts.SupportRadius > 0.0) || !std::isfinite(this->Opts.SupportRadius))
   {
     this->Opts.SupportRadius = 0.0;
@@ -99,6 +121,7 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
   this->Rep = ApproximationReport();
   this->Err.clear();
   this->PU.reset();
+  this->RBFFits.reset();
   this->DeviceUploaded = false;
   this->GlobalDegree = -1;
   n = std::max<Index>(n, 0);
@@ -290,6 +313,7 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
     }
   }
   this->Rep.CloudDimension = dim;
+  this->ResolveAuto(globalValid, dim);
 
   // What else is global, over every part of a distributed cloud (collective, in this order on every part).
   if (partition)
@@ -317,7 +341,8 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
         this->PartitionLSSums[degree] = std::move(sums);
       }
     }
-    else if (this->Opts.Method == ApproximationMethod::PUWLS)
+    else if (this->Opts.Method == ApproximationMethod::PUWLS ||
+      (this->Opts.Method == ApproximationMethod::RBF && !this->RBFIsGlobal()))
     {
       double box[6] = { 0, 0, 0, 0, 0, 0 }; // -umin, umax per axis of the frame
       for (int a = 0; a < dim; ++a)
@@ -416,6 +441,27 @@ bool Approximator::Reach(const double* xyz, Index m, ApproximationReach& reach) 
       reach.K2 = fixed ? 0 : this->Opts.NeighborCount;
       reach.Radius2 = fixed ? R : 0.0;
       break;
+    case ApproximationMethod::RBF:
+      if (this->RBFIsGlobal())
+      {
+        // The global fit reads every point: a radius beyond the cloud's diameter gathers them all (small N).
+        queriesFrom(xyz, m);
+        const double diameter = std::sqrt(std::pow(this->Bounds[1] - this->Bounds[0], 2) +
+          std::pow(this->Bounds[3] - this->Bounds[2], 2) + std::pow(this->Bounds[5] - this->Bounds[4], 2));
+        reach.Radius = std::isfinite(diameter) && diameter > 0.0 ? 2.0 * diameter : 1.0;
+      }
+      else
+      {
+        // RBF-PU: the patches' points, within max(SupportFactor R, SupportFactor d_k) of each node near the
+        // evaluation points (fixed: the support radius); no widening.
+        const double cover = this->PUCentresNear(xyz, m, reach.Queries);
+        reach.K = fixed ? 0 : this->PatchSize();
+        reach.Radius = fixed ? R : this->Opts.SupportFactor * cover * (1.0 + 1e-9);
+        reach.KFactor = fixed ? 1.0 : this->Opts.SupportFactor * (1.0 + 1e-9);
+      }
+      break;
+    case ApproximationMethod::Auto:
+      break; // resolved by SetCloud
     case ApproximationMethod::PUWLS:
     {
       // The lattice centres within R of the evaluation points, each fitted over its neighbours within

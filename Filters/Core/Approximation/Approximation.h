@@ -25,6 +25,12 @@
  *   (Mass and Density arrays) and otherwise V_j = 1 / sum_k W(|x_j - x_k|, h_j) (the inverse number
  *   density); optional Shepard normalisation divides by sum_j V_j W. The kernel is normalised in the
  *   cloud's dimension.
+ * - RBF (ApproximationRBF.h): interpolation by a polyharmonic spline with a polynomial tail (r^2 log r in 2D,
+ *   r^3 in 1D and 3D; TailDegree 1), SciPy's RBFInterpolator defaults, with its Smoothing: one global fit up to
+ *   RBFGlobalLimit valid points (a dense solve), above it RBF-PU, local RBF fits on the PU-WLS lattice blended
+ *   by the partition of unity. Coincident points are merged (mean value); Report().MethodUsed says which ran.
+ * - Auto: resolved by SetCloud from the number of valid points (over every part), the dimension and Smoothing
+ *   (see ResolveAuto in ApproximationRBF.cxx); Report().MethodUsed and MethodReason say what and why.
  *
  * Support radius: with SupportRadius <= 0, h = SupportFactor * (distance to the NeighborCount-th nearest
  * point) at each evaluation point, so that exactly NeighborCount points carry weight (SupportFactor = 1.1);
@@ -68,10 +74,12 @@ enum class ApproximationMethod
   WLS = 1,
   MLS = 2,
   PUWLS = 3,
-  SPH = 4
+  SPH = 4,
+  RBF = 5,
+  Auto = 6
 };
 
-/// "LS", "WLS", "MLS", "PU-WLS", "SPH".
+/// "LS", "WLS", "MLS", "PU-WLS", "SPH", "RBF", "Auto".
 const char* ApproximationMethodName(ApproximationMethod method);
 bool ApproximationMethodFromName(const std::string& name, ApproximationMethod& out);
 
@@ -108,6 +116,13 @@ struct ApproximationOptions
   bool Diagnostics = false;
   double NullValue = 0.0;
   ApproximationBackend Backend = ApproximationBackend::Auto;
+  // RBF (ApproximationRBF.h): SciPy's `smoothing` (lambda added to the kernel matrix's diagonal, the kernel in
+  // data units; 0 interpolates), the tail's degree (1: SciPy's default), the largest cloud solved globally
+  // (larger ones: RBF-PU) and the points per RBF-PU patch (0: kRBFPatchPoints for the cloud's dimension).
+  double Smoothing = 0.0;
+  int TailDegree = 1;
+  Index RBFGlobalLimit = 1000;
+  int PatchPoints = 0;
 };
 
 /// Where the results go (m evaluation points, C components). Null pointers switch outputs off.
@@ -162,7 +177,11 @@ struct ApproximationReport
   Index Widened = 0;         // needed a wider support
   Index DegreeLowered = 0;   // needed a lower degree (degree 0 included)
   Index Centers = 0;         // PU-WLS centres kept
-  int DegreeUsed = 0;        // LS/WLS: degree of the global fit
+  int DegreeUsed = 0;        // LS/WLS: degree of the global fit; RBF: of the polynomial tail (global fit)
+  std::string MethodUsed;    // the method that ran ("RBF (global)", "RBF-PU" or Auto's choice)
+  std::string MethodReason;  // Auto: why; RBF: global or PU and why
+  Index MergedPoints = 0;    // RBF: points merged into a coincident one (duplicates, values averaged)
+  Index Regularized = 0;     // RBF: fits solved by the least-squares fallback (singular or ill-conditioned)
   bool Aborted = false;
   std::string Backend;              // what evaluated: "CPU (oneTBB, 2 threads)" or "CUDA (NVIDIA H200)"
   std::string BackendNote;          // why the CPU ran where the device was asked for (or, Auto, could have run)
@@ -229,6 +248,7 @@ public:
 
 private:
   struct PUData;
+  struct RBFData;
   struct PointResult
   {
     bool Valid;
@@ -277,6 +297,14 @@ private:
   PointResult SPHPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult PUPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const;
+  /// RBF (ApproximationRBF.cxx): Auto's choice for the cloud (SetCloud), the duplicates' merge and the global
+  /// fit or the RBF-PU patches that blend into the m points xyz; the evaluation at one point.
+  void ResolveAuto(Index globalValid, int dimension);
+  bool RBFIsGlobal() const;
+  int PatchSize() const;
+  bool PrepareRBF(const double* xyz, Index m);
+  bool PrepareRBFFits(const double* xyz, Index m);
+  PointResult RBFPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   /// The k nearest points of x (radius <= 0; h = SupportFactor x the k-th distance) or those within radius
   /// (h = radius), in s.Ids / s.Dist2 in the grid's neighbour order (distance, then position): the fits'
   /// sums then do not depend on how the neighbours were found (warm start or not, which points a distributed
@@ -325,6 +353,8 @@ private:
   int GlobalNeighbors = 0;
   double GlobalCondition = 0.0;
   std::unique_ptr<PUData> PU;
+  std::unique_ptr<RBFData> RBFFits;
+  ApproximationMethod Requested = ApproximationMethod::MLS; // Opts.Method before Auto was resolved
   std::unique_ptr<cuda::MLSDevice> Device; // the cloud on the CUDA device (uploaded on first use)
   bool DeviceUploaded = false;
   std::vector<double> DeviceKey; // the options the device copy was uploaded with

@@ -3,6 +3,7 @@
 // global fits of LS (3.1-3.7) and WLS (3.8-3.15).
 #include "Approximation/Approximation.h"
 #include "Approximation/ApproximationPU.h"
+#include "Approximation/ApproximationRBF.h"
 #include "Common/Parallel.h"
 
 #include <algorithm>
@@ -227,11 +228,11 @@ bool Approximator::EvaluateImage(
   const ImageGeometry& image, const ApproximationOutput& out, const ProgressCallback& progress)
 {
   const Index m = std::max<Index>(image.NumberOfPoints(), 0);
-  if (this->Opts.Method != ApproximationMethod::PUWLS)
+  if (this->Opts.Method != ApproximationMethod::PUWLS && this->Opts.Method != ApproximationMethod::RBF)
   {
     return this->EvaluateAt(nullptr, &image, m, out, progress);
   }
-  // PU-WLS places its centres from the evaluation points: it gets them stored.
+  // PU-WLS and RBF-PU place their centres from the evaluation points: they get them stored.
   std::vector<double> xyz(3 * static_cast<size_t>(m));
   for (Index i = 0; i < m; ++i)
   {
@@ -290,6 +291,13 @@ bool Approximator::EvaluateAt(const double* xyz, const ImageGeometry* image, Ind
       break;
     case ApproximationMethod::SPH:
       ready = this->PrepareSPHVolumes();
+      break;
+    case ApproximationMethod::RBF:
+      ready = this->PrepareRBF(xyz, m); // xyz is set (EvaluateImage)
+      break;
+    case ApproximationMethod::Auto:
+      ready = false; // SetCloud resolves it
+      this->Err = "Auto was not resolved (no cloud)";
       break;
     case ApproximationMethod::MLS:
       break;
@@ -387,6 +395,11 @@ bool Approximator::EvaluateAt(const double* xyz, const ImageGeometry* image, Ind
                 break;
               case ApproximationMethod::SPH:
                 r = this->SPHPoint(x, s, out, i);
+                break;
+              case ApproximationMethod::RBF:
+                r = this->RBFPoint(x, s, out, i);
+                break;
+              case ApproximationMethod::Auto:
                 break;
             }
           }

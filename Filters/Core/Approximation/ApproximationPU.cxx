@@ -26,7 +26,7 @@ void Approximator::PULattice(double umin[3], double& spacing, double& cover, Ind
   const int D = this->Frame.Dimension;
   const Index nv = this->GlobalValidPoints;
   const double* sp = this->Points.SortedPoints();
-  const int k = this->Opts.NeighborCount;
+  const int k = this->PatchSize(); // NeighborCount (PU-WLS), the RBF-PU patch size
   constexpr double pi = 3.141592653589793238462643383279502884;
 
   double umax[3] = { 0, 0, 0 }, origin[3];

@@ -1,0 +1,739 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// RBF (global polyharmonic spline or RBF-PU) and Auto's choice of a method; see ApproximationRBF.h.
+#include "Approximation/ApproximationRBF.h"
+#include "Approximation/ApproximationPU.h"
+
+#include "Common/Parallel.h"
+#include "Common/PolynomialBasis.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <new>
+#include <string>
+#include <limits>
+#include <numeric>
+
+namespace meshfree
+{
+
+bool SolvePolyharmonic(int D, int beta, int degree, double lambda, const double* xi, Index n, const double* f, int C,
+  double* w, double* tail, PolyharmonicFit& fit)
+{
+  using Matrix = Eigen::MatrixXd;
+  fit.Condition = std::numeric_limits<double>::infinity();
+  fit.Regularized = false;
+  if (n <= 0)
+  {
+    return false;
+  }
+  // The tail: the highest degree <= `degree` whose basis has full column rank on the centres.
+  int q = 0;
+  Matrix P;
+  int used = -1;
+  for (int d = D > 0 ? std::min(degree, kMaxBasisDegree) : 0; d >= 0 && used < 0; --d)
+  {
+    const RuntimeBasis basis(D, d);
+    q = basis.Size();
+    if (n < q)
+    {
+      continue;
+    }
+    P.resize(n, q);
+    double row[kMaxBasisSize];
+    for (Index j = 0; j < n; ++j)
+    {
+      basis.Evaluate(xi + 3 * j, row);
+      for (int k = 0; k < q; ++k)
+      {
+        P(j, k) = row[k];
+      }
+    }
+    Eigen::ColPivHouseholderQR<Matrix> rank(P);
+    rank.setThreshold(1e-10);
+    if (rank.rank() == q)
+    {
+      used = d;
+    }
+  }
+  if (used < 0)
+  {
+    return false;
+  }
+  fit.Degree = used;
+  Eigen::HouseholderQR<Matrix> qr(P);
+  Matrix B(n, n);
+  for (Index i = 0; i < n; ++i)
+  {
+    const double* a = xi + 3 * i;
+    B(i, i) = lambda;
+    for (Index j = 0; j < i; ++j)
+    {
+      const double* b = xi + 3 * j;
+      double r2 = 0.0;
+      for (int k = 0; k < D; ++k)
+      {
+        r2 += (a[k] - b[k]) * (a[k] - b[k]);
+      }
+      B(i, j) = B(j, i) = PolyharmonicValue(beta, r2);
+    }
+  }
+  Matrix F(n, C);
+  for (Index j = 0; j < n; ++j)
+  {
+    for (int c = 0; c < C; ++c)
+    {
+      F(j, c) = f[j * C + c];
+    }
+  }
+  // Q^T (K + lambda I) Q and Q^T f.
+  B.applyOnTheLeft(qr.householderQ().transpose());
+  B.applyOnTheRight(qr.householderQ());
+  Matrix G = F;
+  G.applyOnTheLeft(qr.householderQ().transpose());
+  const Index m = n - q;
+  Matrix Z(m, C);
+  if (m > 0)
+  {
+    const auto B22 = B.bottomRightCorner(m, m);
+    Eigen::LLT<Matrix> llt(B22);
+    const double rcond = llt.info() == Eigen::Success ? llt.rcond() : 0.0;
+    if (llt.info() == Eigen::Success && rcond > 1.0 / kRBFMaxCondition)
+    {
+      Z = llt.solve(G.bottomRows(m));
+      fit.Condition = 1.0 / rcond;
+    }
+    else
+    {
+      // Least squares: the eigen-decomposition, eigenvalues below 1e-13 of the largest dropped. An
+      // indefinite but regular matrix (a tail below the kernel's order) is solved exactly.
+      Eigen::SelfAdjointEigenSolver<Matrix> eig(B22);
+      if (eig.info() != Eigen::Success)
+      {
+        return false;
+      }
+      const Eigen::VectorXd lambdas = eig.eigenvalues();
+      const double largest = lambdas.cwiseAbs().maxCoeff();
+      Eigen::VectorXd inverse(m);
+      double smallest = std::numeric_limits<double>::infinity();
+      for (Index k = 0; k < m; ++k)
+      {
+        const double l = std::fabs(lambdas(k));
+        const bool keep = l > 1e-13 * largest && l > 0.0;
+        inverse(k) = keep ? 1.0 / lambdas(k) : 0.0;
+        fit.Regularized = fit.Regularized || !keep;
+        smallest = std::min(smallest, l);
+      }
+      Z = eig.eigenvectors() * (inverse.asDiagonal() * (eig.eigenvectors().transpose() * G.bottomRows(m)));
+      fit.Condition = smallest > 0.0 ? largest / smallest : std::numeric_limits<double>::infinity();
+    }
+  }
+  else
+  {
+    fit.Condition = 1.0;
+  }
+  // R c = G1 - B12 z; w = Q [0; z].
+  Matrix T = G.topRows(q);
+  if (m > 0)
+  {
+    T.noalias() -= B.topRightCorner(q, m) * Z;
+  }
+  const Matrix c = qr.matrixQR().topLeftCorner(q, q).triangularView<Eigen::Upper>().solve(T);
+  Matrix Wm = Matrix::Zero(n, C);
+  if (m > 0)
+  {
+    Wm.bottomRows(m) = Z;
+  }
+  Wm.applyOnTheLeft(qr.householderQ());
+  bool finite = c.allFinite() && Wm.allFinite();
+  if (!finite)
+  {
+    return false;
+  }
+  for (Index j = 0; j < n; ++j)
+  {
+    for (int k = 0; k < C; ++k)
+    {
+      w[j * C + k] = Wm(j, k);
+    }
+  }
+  std::fill(tail, tail + static_cast<size_t>(kMaxBasisSize) * C, 0.0);
+  for (int a = 0; a < q; ++a)
+  {
+    for (int k = 0; k < C; ++k)
+    {
+      tail[a * C + k] = c(a, k);
+    }
+  }
+  return true;
+}
+
+void EvaluatePolyharmonic(int D, int beta, const PolyharmonicFit& fit, const double* centers, const double* weights,
+  const double* tail, const double* xi, int C, double* out, double* gradient)
+{
+  EvaluateFit(D, fit.Degree, xi, tail, C, out, gradient);
+  const double* X = centers + 3 * fit.Offset;
+  const double* W = weights + static_cast<size_t>(fit.Offset) * C;
+  const Index n = fit.Count;
+  if (C == 1 && !gradient)
+  {
+    // The common case (one scalar field): a tight loop.
+    double sum = 0.0;
+    if (D == 2)
+    {
+      for (Index j = 0; j < n; ++j)
+      {
+        const double dx = xi[0] - X[3 * j], dy = xi[1] - X[3 * j + 1];
+        const double r2 = dx * dx + dy * dy;
+        sum += 0.5 * r2 * KernelLog(r2 > 1e-300 ? r2 : 1.0) * W[j];
+      }
+    }
+    else
+    {
+      for (Index j = 0; j < n; ++j)
+      {
+        double r2 = 0.0;
+        for (int a = 0; a < D; ++a)
+        {
+          r2 += (xi[a] - X[3 * j + a]) * (xi[a] - X[3 * j + a]);
+        }
+        sum += PolyharmonicValue(beta, r2) * W[j];
+      }
+    }
+    out[0] += sum;
+    return;
+  }
+  for (Index j = 0; j < n; ++j)
+  {
+    double d[3] = { 0, 0, 0 };
+    double r2 = 0.0;
+    for (int a = 0; a < D; ++a)
+    {
+      d[a] = xi[a] - X[3 * j + a];
+      r2 += d[a] * d[a];
+    }
+    const double phi = PolyharmonicValue(beta, r2);
+    const double* wj = W + static_cast<size_t>(j) * C;
+    for (int c = 0; c < C; ++c)
+    {
+      out[c] += phi * wj[c];
+    }
+    if (gradient)
+    {
+      const double slope = PolyharmonicSlope(beta, r2);
+      for (int a = 0; a < D; ++a)
+      {
+        const double g = slope * d[a];
+        for (int c = 0; c < C; ++c)
+        {
+          gradient[a * C + c] += g * wj[c];
+        }
+      }
+    }
+  }
+}
+
+bool Approximator::RBFIsGlobal() const
+{
+  return this->Frame.Dimension == 0 || this->GlobalValidPoints <= this->Opts.RBFGlobalLimit;
+}
+
+int Approximator::PatchSize() const
+{
+  if (this->Opts.Method != ApproximationMethod::RBF)
+  {
+    return this->Opts.NeighborCount;
+  }
+  return this->Opts.PatchPoints > 0 ? this->Opts.PatchPoints
+                                    : kRBFPatchPoints[std::min(std::max(this->Frame.Dimension, 0), 3)];
+}
+
+void Approximator::ResolveAuto(Index globalValid, int dimension)
+{
+  this->Opts.Method = this->Requested;
+  char text[320];
+  if (this->Requested == ApproximationMethod::Auto)
+  {
+    // Measured with Testing/Benchmarks/run_benchmarks.py (Renka & Brown's ten functions in 2D, a 3D Franke field,
+    // N = 100 to 10,000; README, "Run time against error"). 2D: the global thin-plate spline is the most accurate
+    // MeshFree setting on 8 of 10 functions at N = 100, PU-WLS of degree 3 is within 2x of the best error at a
+    // fraction of the time on every function from N = 300 on (degree 3 converges like h^4, the thin-plate
+    // spline like h^2). 1D and 3D: r^3 (global, RBF-PU above RBFGlobalLimit) is the most accurate at every N
+    // measured. With smoothing (noisy data): the smoothing spline up to RBFGlobalLimit, a moving least-squares fit
+    // (which does not interpolate) above.
+    const bool smoothing = this->Opts.Smoothing > 0.0;
+    const Index small2D = std::min<Index>(kAutoRBFPoints2D, this->Opts.RBFGlobalLimit);
+    if (dimension == 0)
+    {
+      this->Opts.Method = ApproximationMethod::RBF;
+      std::snprintf(text, sizeof(text), "every valid point at one position: their mean value");
+    }
+    else if (smoothing)
+    {
+      const bool rbf = globalValid <= this->Opts.RBFGlobalLimit;
+      this->Opts.Method = rbf ? ApproximationMethod::RBF : ApproximationMethod::MLS;
+      std::snprintf(text, sizeof(text),
+        rbf ? "Smoothing > 0 (noisy data), %lld valid points <= RBFGlobalLimit %lld: the global smoothing spline"
+            : "Smoothing > 0 (noisy data), %lld valid points > RBFGlobalLimit %lld: MLS, a least-squares fit that "
+              "averages the noise",
+        static_cast<long long>(globalValid), static_cast<long long>(this->Opts.RBFGlobalLimit));
+    }
+    else if (dimension == 2 && globalValid > small2D)
+    {
+      this->Opts.Method = ApproximationMethod::PUWLS;
+      this->Opts.Degree = std::max(this->Opts.Degree, 3);
+      std::snprintf(text, sizeof(text),
+        "2D cloud of %lld valid points > %lld: PU-WLS of degree %d, as accurate as the thin-plate spline or more "
+        "(it converges faster) at a fraction of its time",
+        static_cast<long long>(globalValid), static_cast<long long>(small2D), this->Opts.Degree);
+    }
+    else
+    {
+      this->Opts.Method = ApproximationMethod::RBF;
+      const bool global = globalValid <= this->Opts.RBFGlobalLimit;
+      if (dimension == 2)
+      {
+        std::snprintf(text, sizeof(text),
+          "2D cloud of %lld valid points <= %lld: the global thin-plate spline, the most accurate at this size",
+          static_cast<long long>(globalValid), static_cast<long long>(small2D));
+      }
+      else
+      {
+        std::snprintf(text, sizeof(text), "%dD cloud of %lld valid points: the polyharmonic spline r^3 (%s), the most "
+                                          "accurate here",
+          dimension, static_cast<long long>(globalValid), global ? "one global fit" : "RBF-PU above RBFGlobalLimit");
+      }
+    }
+    this->Rep.MethodReason = text;
+  }
+  if (this->Opts.Method == ApproximationMethod::RBF)
+  {
+    const bool global = dimension == 0 || globalValid <= this->Opts.RBFGlobalLimit;
+    this->Rep.MethodUsed = global ? "RBF (global)" : "RBF-PU";
+    if (this->Requested != ApproximationMethod::Auto)
+    {
+      std::snprintf(text, sizeof(text), "%lld valid points %s RBFGlobalLimit %lld: %s",
+        static_cast<long long>(globalValid), global ? "<=" : ">", static_cast<long long>(this->Opts.RBFGlobalLimit),
+        global ? "one global fit" : "a partition of unity of local fits");
+      this->Rep.MethodReason = text;
+    }
+  }
+  else
+  {
+    this->Rep.MethodUsed = ApproximationMethodName(this->Opts.Method);
+    if (this->Requested == ApproximationMethod::Auto)
+    {
+      this->Rep.MethodUsed += " degree " + std::to_string(this->Opts.Degree);
+    }
+  }
+}
+
+namespace
+{
+/// The kernel's exponent beta in the cloud's intrinsic dimension: r^2 log r in 2D, r^3 otherwise.
+int KernelBeta(int dimension)
+{
+  return dimension == 2 ? 2 : 3;
+}
+} // namespace
+
+bool Approximator::PrepareRBF(const double* xyz, Index count)
+{
+  // The dense systems are allocated here (N^2 doubles for the global fit): running out of memory is an error
+  // with a message, not a crash.
+  try
+  {
+    return this->PrepareRBFFits(xyz, count);
+  }
+  catch (const std::bad_alloc&)
+  {
+    this->RBFFits.reset();
+    this->Err = "not enough memory for the RBF systems (" + std::to_string(this->GlobalValidPoints) +
+      " points; lower RBFGlobalLimit to use RBF-PU)";
+  }
+  catch (const std::exception& e)
+  {
+    this->RBFFits.reset();
+    this->Err = std::string("the RBF fit failed: ") + e.what();
+  }
+  return false;
+}
+
+bool Approximator::PrepareRBFFits(const double* xyz, Index count)
+{
+  this->RBFFits.reset(new RBFData);
+  RBFData& rbf = *this->RBFFits;
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const Index n = static_cast<Index>(this->Coordinates.size() / 3);
+  const double* coords = this->Coordinates.data();
+  rbf.Beta = KernelBeta(D);
+  rbf.Global = this->RBFIsGlobal();
+  this->Rep.MergedPoints = 0;
+  this->Rep.Regularized = 0;
+
+  // Duplicates: each valid point (in id order) absorbs the not yet absorbed points within 1e-10 of the
+  // diameter; the values of a kept point are the mean over the points it absorbed.
+  const double diameter = std::sqrt(std::pow(this->Bounds[1] - this->Bounds[0], 2) +
+    std::pow(this->Bounds[3] - this->Bounds[2], 2) + std::pow(this->Bounds[5] - this->Bounds[4], 2));
+  const double tolerance = std::isfinite(diameter) ? 1e-10 * diameter : 0.0;
+  rbf.Kept.assign(static_cast<size_t>(n), 0);
+  rbf.Values = this->Values;
+  std::vector<unsigned char> absorbed(static_cast<size_t>(n), 0);
+  std::vector<Index> ids;
+  std::vector<double> d2;
+  for (Index i = 0; i < n; ++i)
+  {
+    const double* x = coords + 3 * i;
+    if (absorbed[i] || !(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2])))
+    {
+      continue;
+    }
+    rbf.Kept[i] = 1;
+    absorbed[i] = 1;
+    this->Points.FindWithinRadius(x, tolerance, ids, &d2);
+    int merged = 1;
+    for (Index j : ids)
+    {
+      if (absorbed[j])
+      {
+        continue;
+      }
+      absorbed[j] = 1;
+      ++merged;
+      for (int c = 0; c < C; ++c)
+      {
+        rbf.Values[static_cast<size_t>(i) * C + c] += this->Values[static_cast<size_t>(j) * C + c];
+      }
+    }
+    if (merged > 1)
+    {
+      this->Rep.MergedPoints += merged - 1;
+      for (int c = 0; c < C; ++c)
+      {
+        rbf.Values[static_cast<size_t>(i) * C + c] /= merged;
+      }
+    }
+  }
+  const size_t tailStride = static_cast<size_t>(kMaxBasisSize) * C;
+
+  if (rbf.Global)
+  {
+    // One fit over every kept point, centred at their centroid and scaled by the largest distance from it.
+    std::vector<Index> kept;
+    double centre[3] = { 0, 0, 0 };
+    for (Index i = 0; i < n; ++i)
+    {
+      if (rbf.Kept[i])
+      {
+        kept.push_back(i);
+        for (int a = 0; a < 3; ++a)
+        {
+          centre[a] += coords[3 * i + a];
+        }
+      }
+    }
+    const Index nk = static_cast<Index>(kept.size());
+    if (nk == 0)
+    {
+      this->Err = "the cloud has no valid point";
+      return false;
+    }
+    for (double& v : centre)
+    {
+      v /= static_cast<double>(nk);
+    }
+    double largest2 = 0.0;
+    for (Index i : kept)
+    {
+      double r2 = 0.0;
+      for (int a = 0; a < 3; ++a)
+      {
+        r2 += (coords[3 * i + a] - centre[a]) * (coords[3 * i + a] - centre[a]);
+      }
+      largest2 = std::max(largest2, r2);
+    }
+    const double scale = largest2 > 0.0 && std::isfinite(largest2) ? std::sqrt(largest2) : 1.0;
+    PolyharmonicFit fit;
+    std::copy(centre, centre + 3, fit.Origin);
+    fit.InvScale = 1.0 / scale;
+    fit.Count = nk;
+    rbf.X.assign(3 * static_cast<size_t>(nk), 0.0);
+    std::vector<double> f(static_cast<size_t>(nk) * C);
+    for (Index j = 0; j < nk; ++j)
+    {
+      const Index id = kept[j];
+      const double dx[3] = { coords[3 * id] - centre[0], coords[3 * id + 1] - centre[1], coords[3 * id + 2] - centre[2] };
+      this->Frame.Project<3>(dx, fit.InvScale, &rbf.X[3 * j]);
+      for (int a = D; a < 3; ++a)
+      {
+        rbf.X[3 * j + a] = 0.0;
+      }
+      std::copy_n(&rbf.Values[static_cast<size_t>(id) * C], C, &f[static_cast<size_t>(j) * C]);
+    }
+    rbf.W.assign(static_cast<size_t>(nk) * C, 0.0);
+    rbf.Tail.assign(tailStride, 0.0);
+    const double lambda = this->Opts.Smoothing * std::pow(fit.InvScale, rbf.Beta);
+    if (!SolvePolyharmonic(D, rbf.Beta, this->Opts.TailDegree, lambda, rbf.X.data(), nk, f.data(), C, rbf.W.data(),
+          rbf.Tail.data(), fit))
+    {
+      this->Err = "the global RBF system has no finite solution";
+      return false;
+    }
+    this->Rep.Regularized = fit.Regularized ? 1 : 0;
+    this->Rep.DegreeUsed = fit.Degree;
+    this->Rep.Centers = 1;
+    rbf.Fits.push_back(fit);
+    return true;
+  }
+
+  // RBF-PU: the lattice of PU-WLS (spacing from the patch size), the nodes within R of the points to evaluate.
+  const int k = this->PatchSize();
+  std::vector<double> nodes;
+  const double cover = this->PUCentresNear(xyz, count, nodes);
+  rbf.CoverRadius = cover;
+  const Index nodeCount = static_cast<Index>(nodes.size() / 3);
+  struct Patch
+  {
+    PolyharmonicFit Fit;
+    std::vector<double> X, W, Tail;
+    bool Ok = false;
+  };
+  std::vector<Patch> patches(static_cast<size_t>(nodeCount));
+  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  const int cap = kRBFPatchCap * k;
+  ParallelFor(nodeCount, 4, [&](Index begin, Index end) {
+    FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+    std::vector<std::pair<double, Index>> chosen;
+    std::vector<double> f;
+    for (Index node = begin; node < end; ++node)
+    {
+      const double* x = &nodes[3 * node];
+      double h = this->Opts.SupportRadius;
+      if (!(h > 0.0))
+      {
+        this->Neighbors(x, k, 0.0, s, h);
+        h = std::max(h, this->Opts.SupportFactor * cover);
+      }
+      this->Points.FindWithinRadius(x, h, s.Ids, &s.Dist2);
+      const bool covered =
+        std::any_of(s.Dist2.begin(), s.Dist2.end(), [&](double v) { return v < cover * cover; });
+      if (!covered)
+      {
+        continue; // blends nothing
+      }
+      chosen.clear();
+      for (size_t j = 0; j < s.Ids.size(); ++j)
+      {
+        if (rbf.Kept[s.Ids[j]])
+        {
+          chosen.emplace_back(s.Dist2[j], s.Ids[j]);
+        }
+      }
+      if (static_cast<int>(chosen.size()) > cap)
+      {
+        std::nth_element(chosen.begin(), chosen.begin() + (cap - 1), chosen.end());
+        chosen.resize(cap);
+      }
+      // By id: the fit does not depend on how the points were found.
+      std::sort(chosen.begin(), chosen.end(),
+        [](const std::pair<double, Index>& a, const std::pair<double, Index>& b) { return a.second < b.second; });
+      Patch& p = patches[static_cast<size_t>(node)];
+      const Index m = static_cast<Index>(chosen.size());
+      std::copy(x, x + 3, p.Fit.Origin);
+      p.Fit.InvScale = 1.0 / h;
+      p.Fit.Count = m;
+      p.X.assign(3 * static_cast<size_t>(m), 0.0);
+      f.resize(static_cast<size_t>(m) * C);
+      for (Index j = 0; j < m; ++j)
+      {
+        const Index id = chosen[j].second;
+        const double dx[3] = { coords[3 * id] - x[0], coords[3 * id + 1] - x[1], coords[3 * id + 2] - x[2] };
+        this->Frame.Project<3>(dx, p.Fit.InvScale, &p.X[3 * j]);
+        for (int a = D; a < 3; ++a)
+        {
+          p.X[3 * j + a] = 0.0;
+        }
+        std::copy_n(&rbf.Values[static_cast<size_t>(id) * C], C, &f[static_cast<size_t>(j) * C]);
+      }
+      p.W.assign(static_cast<size_t>(m) * C, 0.0);
+      p.Tail.assign(tailStride, 0.0);
+      const double lambda = this->Opts.Smoothing * std::pow(p.Fit.InvScale, rbf.Beta);
+      p.Ok = SolvePolyharmonic(
+        D, rbf.Beta, this->Opts.TailDegree, lambda, p.X.data(), m, f.data(), C, p.W.data(), p.Tail.data(), p.Fit);
+    }
+  });
+  Index kept = 0;
+  for (Index node = 0; node < nodeCount; ++node)
+  {
+    Patch& p = patches[static_cast<size_t>(node)];
+    if (!p.Ok)
+    {
+      continue;
+    }
+    p.Fit.Offset = static_cast<Index>(rbf.X.size() / 3);
+    rbf.X.insert(rbf.X.end(), p.X.begin(), p.X.end());
+    rbf.W.insert(rbf.W.end(), p.W.begin(), p.W.end());
+    rbf.Tail.insert(rbf.Tail.end(), p.Tail.begin(), p.Tail.end());
+    rbf.Centers.insert(rbf.Centers.end(), &nodes[3 * node], &nodes[3 * node] + 3);
+    rbf.Fits.push_back(p.Fit);
+    this->Rep.Regularized += p.Fit.Regularized ? 1 : 0;
+    ++kept;
+  }
+  this->Rep.Centers = kept;
+  if (kept == 0)
+  {
+    this->Err = "no RBF-PU patch has a finite fit";
+    return false;
+  }
+  rbf.CenterGrid.Build(rbf.Centers.data(), kept);
+  return true;
+}
+
+Approximator::PointResult Approximator::RBFPoint(
+  const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const
+{
+  PointResult result{ false, 0, 0.0, false, false };
+  const RBFData& rbf = *this->RBFFits;
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const bool gradient = out.Gradients != nullptr;
+  const size_t tailStride = static_cast<size_t>(kMaxBasisSize) * C;
+  // Work: blended values (C), blended local gradients (3C), one fit's values (C) and gradients (3C).
+  if (s.Work.size() < 8 * static_cast<size_t>(C) + 8)
+  {
+    s.Work.resize(8 * static_cast<size_t>(C) + 8);
+  }
+  double* sumValues = s.Work.data();
+  double* sumGrad = sumValues + C;
+  double* local = sumGrad + 3 * C;
+  double* localGrad = local + C;
+  bool finite = true;
+  if (rbf.Global)
+  {
+    const PolyharmonicFit& fit = rbf.Fits[0];
+    const double dx[3] = { x[0] - fit.Origin[0], x[1] - fit.Origin[1], x[2] - fit.Origin[2] };
+    double xi[3] = { 0, 0, 0 };
+    this->Frame.Project<3>(dx, fit.InvScale, xi);
+    for (int a = D; a < 3; ++a)
+    {
+      xi[a] = 0.0;
+    }
+    EvaluatePolyharmonic(D, rbf.Beta, fit, rbf.X.data(), rbf.W.data(), rbf.Tail.data(), xi, C, local,
+      gradient ? localGrad : nullptr);
+    for (int q = 0; q < C; ++q)
+    {
+      finite = finite && std::isfinite(local[q]);
+      if (out.Values)
+      {
+        out.Values[i * C + q] = local[q];
+      }
+      if (gradient)
+      {
+        double l[3] = { 0, 0, 0 };
+        for (int a = 0; a < D; ++a)
+        {
+          l[a] = localGrad[a * C + q] * fit.InvScale;
+        }
+        double* g = out.Gradients + 3 * (i * C + q);
+        this->Frame.Unproject(l, g);
+        finite = finite && std::isfinite(g[0]) && std::isfinite(g[1]) && std::isfinite(g[2]);
+      }
+    }
+    result.Valid = finite;
+    result.Neighbors = static_cast<int>(std::min<Index>(fit.Count, 2147483647));
+    result.Condition = fit.Condition;
+    result.Lowered = fit.Degree < this->Opts.TailDegree;
+    return result;
+  }
+
+  // RBF-PU: the fits whose node lies within R, blended as PU-WLS blends its fits (3.16-3.21).
+  const double R = rbf.CoverRadius;
+  rbf.CenterGrid.FindWithinRadius(x, R, s.Ids, &s.Dist2);
+  SortById(s, s.Ids.size());
+  std::fill(sumValues, sumValues + 4 * C, 0.0);
+  double sumTheta = 0.0;
+  double sumDTheta[3] = { 0, 0, 0 };
+  double best = 0.0;
+  for (size_t j = 0; j < s.Ids.size(); ++j)
+  {
+    const double theta = this->UnitKernel.ValueSquared(s.Dist2[j] / (R * R));
+    if (!(theta > 0.0))
+    {
+      continue;
+    }
+    const Index c = s.Ids[j];
+    const PolyharmonicFit& fit = rbf.Fits[c];
+    const double dx[3] = { x[0] - fit.Origin[0], x[1] - fit.Origin[1], x[2] - fit.Origin[2] };
+    double xi[3] = { 0, 0, 0 };
+    this->Frame.Project<3>(dx, fit.InvScale, xi);
+    for (int a = D; a < 3; ++a)
+    {
+      xi[a] = 0.0;
+    }
+    EvaluatePolyharmonic(D, rbf.Beta, fit, rbf.X.data(), rbf.W.data(), &rbf.Tail[tailStride * c], xi, C, local,
+      gradient ? localGrad : nullptr);
+    sumTheta += theta;
+    for (int q = 0; q < C; ++q)
+    {
+      sumValues[q] += theta * local[q];
+    }
+    if (gradient)
+    {
+      double r[3] = { 0, 0, 0 }, dTheta[3];
+      this->Frame.Project<3>(dx, 1.0 / R, r);
+      for (int a = D; a < 3; ++a)
+      {
+        r[a] = 0.0;
+      }
+      this->UnitKernel.Gradient(r, dTheta); // per unit r / R
+      for (int a = 0; a < D; ++a)
+      {
+        dTheta[a] /= R;
+        sumDTheta[a] += dTheta[a];
+        for (int q = 0; q < C; ++q)
+        {
+          sumGrad[a * C + q] += dTheta[a] * local[q] + theta * localGrad[a * C + q] * fit.InvScale;
+        }
+      }
+    }
+    if (theta > best)
+    {
+      best = theta;
+      result.Neighbors = static_cast<int>(fit.Count);
+      result.Condition = fit.Condition;
+      result.Lowered = fit.Degree < this->Opts.TailDegree;
+    }
+  }
+  if (!(sumTheta > 0.0))
+  {
+    return result;
+  }
+  for (int q = 0; q < C; ++q)
+  {
+    const double f = sumValues[q] / sumTheta;
+    finite = finite && std::isfinite(f);
+    if (out.Values)
+    {
+      out.Values[i * C + q] = f;
+    }
+    if (gradient)
+    {
+      double l[3] = { 0, 0, 0 };
+      for (int a = 0; a < D; ++a)
+      {
+        l[a] = (sumGrad[a * C + q] - f * sumDTheta[a]) / sumTheta;
+      }
+      double* g = out.Gradients + 3 * (i * C + q);
+      this->Frame.Unproject(l, g);
+      finite = finite && std::isfinite(g[0]) && std::isfinite(g[1]) && std::isfinite(g[2]);
+    }
+  }
+  result.Valid = finite;
+  return result;
+}
+
+} // namespace meshfree
