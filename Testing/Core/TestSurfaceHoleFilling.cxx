@@ -3,6 +3,7 @@
 // (VirtualScan.h) of a sphere and a torus whose underside no viewpoint sees, reconstructed with HoleFilling
 // on (closed, one piece, chi right, tight where there are no samples), off (open, the border near the data's
 // border) and a single-view scan (open, no islands); DistanceToData; the winding number itself.
+#include "Surface/DataSupport.h"
 #include "Surface/HoleFilling.h"
 #include "Surface/MeshTopology.h"
 #include "Surface/SurfaceReconstruction.h"
@@ -348,4 +349,66 @@ TEST(SurfaceHoleFilling, DistanceToDataIsZeroOnTheDataAndGrowsAcrossTheHole)
   EXPECT_GT(rim, 0.1);
   EXPECT_GT(centre, rim + 0.3);
   EXPECT_LT(centre, 1.0);
+}
+
+TEST(SurfaceHoleFilling, PiecesFewSamplesSupportAreRemoved)
+{
+  // Two closed octahedra: a big one (radius 1) that 200 samples lie on, a small one (radius 0.05, at x = 3)
+  // with 5 samples near it; at least 20 samples must support a piece.
+  TriangleMesh mesh;
+  auto octahedron = [&mesh](double cx, double radius) {
+    const Index base = mesh.NumberOfPoints();
+    const double v[6][3] = { { 1, 0, 0 }, { -1, 0, 0 }, { 0, 1, 0 }, { 0, -1, 0 }, { 0, 0, 1 }, { 0, 0, -1 } };
+    for (const auto& p : v)
+    {
+      mesh.Points.insert(mesh.Points.end(), { cx + radius * p[0], radius * p[1], radius * p[2] });
+    }
+    const Index faces[8][3] = { { 0, 2, 4 }, { 2, 1, 4 }, { 1, 3, 4 }, { 3, 0, 4 }, { 2, 0, 5 }, { 1, 2, 5 }, { 3, 1, 5 },
+      { 0, 3, 5 } };
+    for (const auto& f : faces)
+    {
+      mesh.Triangles.insert(mesh.Triangles.end(), { base + f[0], base + f[1], base + f[2] });
+    }
+  };
+  octahedron(0.0, 1.0);
+  octahedron(3.0, 0.05);
+  std::vector<double> samples;
+  for (int i = 0; i < 200; ++i)
+  {
+    const int corner = i % 6;
+    samples.insert(samples.end(), &mesh.Points[3 * corner], &mesh.Points[3 * corner] + 3);
+    samples.back() += 1e-3 * i; // distinct points near the big octahedron's corners
+  }
+  for (int i = 0; i < 5; ++i)
+  {
+    samples.insert(samples.end(), { 3.0 + 0.05, 0.0, 0.001 * i });
+  }
+  NeighborGrid grid;
+  grid.Build(samples.data(), static_cast<Index>(samples.size() / 3));
+  const std::vector<double> limit(samples.size() / 3, 0.5);
+  Index pieces = 0, removed = 0;
+  const std::vector<unsigned char> keep = SupportedPieces(mesh, grid, limit, 20, pieces, removed);
+  EXPECT_EQ(pieces, 2);
+  EXPECT_EQ(removed, 1);
+  ASSERT_EQ(keep.size(), 16u);
+  for (size_t t = 0; t < 16; ++t)
+  {
+    EXPECT_EQ(keep[t], t < 8 ? 1 : 0) << "triangle " << t;
+  }
+  // Kept alone, the compacted mesh is the big octahedron, its per-vertex values following their vertices.
+  std::vector<double> values;
+  for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
+  {
+    values.push_back(static_cast<double>(v));
+  }
+  EXPECT_EQ(KeepTriangles(mesh, keep, { { &values, 1 } }), 8);
+  EXPECT_EQ(mesh.NumberOfPoints(), 6);
+  EXPECT_EQ(values, std::vector<double>({ 0, 1, 2, 3, 4, 5 }));
+  const MeshTopology topo = ComputeMeshTopology(mesh.Triangles, mesh.NumberOfPoints());
+  EXPECT_TRUE(topo.Closed());
+  EXPECT_EQ(topo.EulerCharacteristic, 2);
+  // With fewer samples than the minimum everywhere, the best-supported piece is still kept.
+  const std::vector<unsigned char> none = SupportedPieces(mesh, grid, limit, 1000, pieces, removed);
+  EXPECT_EQ(removed, 0);
+  EXPECT_EQ(none, std::vector<unsigned char>(8, 1));
 }
