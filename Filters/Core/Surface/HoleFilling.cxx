@@ -2,6 +2,8 @@
 // The fitted surface continued by the winding number (HoleFilling.h).
 #include "Surface/HoleFilling.h"
 
+#include "Surface/PointSetSurface.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,14 +11,18 @@
 namespace meshfree
 {
 
-void FilledField::Set(const ImplicitField& fit, const WindingNumber& winding, const NeighborGrid& grid, const double* supports)
+void FilledField::Set(const ImplicitField& fit, const NeighborGrid& grid, const double* supports, const double* points,
+  const double* normals, const double* areas, Index count)
 {
   this->Fit = &fit;
-  this->Winding = &winding;
+  // The MLS fit leaves every sample within its query radius (>= each support) in the scratch.
+  this->FitQueriesSamples = dynamic_cast<const PointSetSurface*>(&fit) != nullptr;
+  this->Points = points;
+  this->Normals = normals;
+  this->Areas = areas;
+  this->Count = count;
   this->Grid = &grid;
   const std::vector<Index>& order = grid.SortedOrder();
-  this->InverseSupport.assign(order.size(), 0.0);
-  this->QueryRadius = 0.0;
   std::vector<double> valid;
   for (size_t s = 0; s < order.size(); ++s)
   {
@@ -26,24 +32,15 @@ void FilledField::Set(const ImplicitField& fit, const WindingNumber& winding, co
       valid.push_back(h);
     }
   }
-  double median = 0.0;
-  if (!valid.empty())
-  {
-    std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
-    median = valid[valid.size() / 2];
-  }
   // One scale for every sample, the median support: a sample's own support is inflated where the sampling
   // is sparse or one-sided (a scan's grazing border), and blending over it let the fits' extrapolation and the
   // winding number's film meet at an angle, folding the surface (measured: dihedral angles up to 178 degrees in
   // the filled part of a virtual scan, against 102-110 with the median).
-  for (size_t s = 0; s < order.size(); ++s)
+  this->InverseScale = 0.0;
+  if (!valid.empty())
   {
-    const double h = supports[order[s]];
-    if (h > 0.0 && std::isfinite(h))
-    {
-      this->InverseSupport[s] = 1.0 / median;
-      this->QueryRadius = median;
-    }
+    std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
+    this->InverseScale = 1.0 / valid[valid.size() / 2];
   }
   double b[6];
   grid.GetBounds(b);
@@ -53,30 +50,50 @@ void FilledField::Set(const ImplicitField& fit, const WindingNumber& winding, co
   this->GradientFloor = diagonal > 0.0 ? 1e-3 / diagonal : 1.0;
 }
 
-double FilledField::Blend(const double x[3], double gradient[3], FieldScratch& s) const
+const WindingNumber& FilledField::Winding() const
+{
+  std::call_once(this->Once, [this]() {
+    this->Tree.Build(this->Points, this->Normals, this->Areas, this->Count);
+    this->Built = true;
+  });
+  return this->Tree;
+}
+
+double FilledField::Blend(const double x[3], double gradient[3], FieldScratch& scratch, bool fitQueried) const
 {
   if (gradient)
   {
     std::fill(gradient, gradient + 3, 0.0);
   }
-  if (!(this->QueryRadius > 0.0))
+  if (!(this->InverseScale > 0.0))
   {
     return 1.0;
   }
-  this->Grid->FindWithinRadiusPositions(x, this->QueryRadius, s.Positions, s.Dist2);
-  double best = std::numeric_limits<double>::infinity();
-  Index nearest = -1;
-  for (size_t j = 0; j < s.Positions.size(); ++j)
+  // The nearest sample: among the neighbours the MLS fit has just gathered (all samples within the largest
+  // support, at least the median one), else by a k = 1 query.
+  const double* p = nullptr;
+  double d2 = std::numeric_limits<double>::infinity();
+  if (fitQueried)
   {
-    const double inv = this->InverseSupport[s.Positions[j]];
-    const double q2 = s.Dist2[j] * inv * inv;
-    if (inv > 0.0 && q2 < best)
+    for (size_t j = 0; j < scratch.Dist2.size(); ++j)
     {
-      best = q2;
-      nearest = s.Positions[j];
+      if (scratch.Dist2[j] < d2)
+      {
+        d2 = scratch.Dist2[j];
+        p = this->Grid->SortedPoints() + 3 * scratch.Positions[j];
+      }
     }
   }
-  if (nearest < 0 || !(best < 1.0))
+  else
+  {
+    Index id = -1;
+    if (this->Grid->FindKNearest(x, 1, &id, &d2) == 1)
+    {
+      p = this->Points + 3 * id;
+    }
+  }
+  const double best = d2 * this->InverseScale * this->InverseScale;
+  if (!p || !(best < 1.0))
   {
     return 1.0;
   }
@@ -88,8 +105,7 @@ double FilledField::Blend(const double x[3], double gradient[3], FieldScratch& s
   }
   if (gradient && q > 0.0)
   {
-    const double* p = this->Grid->SortedPoints() + 3 * nearest;
-    const double inv = this->InverseSupport[nearest];
+    const double inv = this->InverseScale;
     const double dtdq = 6.0 * u * (1.0 - u) / (1.0 - Inner);
     for (int a = 0; a < 3; ++a)
     {
@@ -102,15 +118,15 @@ double FilledField::Blend(const double x[3], double gradient[3], FieldScratch& s
 
 double FilledField::BlendWeight(const double x[3], FieldScratch& scratch) const
 {
-  return this->Blend(x, nullptr, scratch);
+  return this->Blend(x, nullptr, scratch, false);
 }
 
 bool FilledField::Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& scratch) const
 {
-  double gt[3];
-  double t = this->Blend(x, gradient ? gt : nullptr, scratch);
-  double fFit = 0.0, gFit[3] = { 0.0, 0.0, 0.0 };
-  if (t < 1.0 && !this->Fit->Evaluate(x, fFit, gradient ? gFit : nullptr, scratch))
+  double fFit = 0.0, gFit[3] = { 0.0, 0.0, 0.0 }, gt[3] = { 0.0, 0.0, 0.0 };
+  const bool fitted = this->Fit->Evaluate(x, fFit, gradient ? gFit : nullptr, scratch);
+  double t = this->Blend(x, gradient ? gt : nullptr, scratch, this->FitQueriesSamples);
+  if (!fitted)
   {
     t = 1.0; // no fit here: the winding number alone
     std::fill(gt, gt + 3, 0.0);
@@ -125,7 +141,7 @@ bool FilledField::Evaluate(const double x[3], double& value, double gradient[3],
     return true;
   }
   double gw[3];
-  const double w = this->Winding->Evaluate(x, gw);
+  const double w = this->Winding().Evaluate(x, gw);
   const double len = std::max(std::sqrt(gw[0] * gw[0] + gw[1] * gw[1] + gw[2] * gw[2]), this->GradientFloor);
   const double fW = (0.5 - w) / len;
   value = (1.0 - t) * fFit + t * fW;

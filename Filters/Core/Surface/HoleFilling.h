@@ -26,6 +26,8 @@
 #include "Surface/ImplicitField.h"
 #include "Surface/WindingNumber.h"
 
+#include <atomic>
+#include <mutex>
 #include <vector>
 
 namespace meshfree
@@ -34,9 +36,16 @@ namespace meshfree
 class FilledField : public ImplicitField
 {
 public:
-  /// `fit` and `winding` must outlive this field; `grid` is the cloud's; `supports` the fit supports h_i in
-  /// the caller's point order (points with h_i <= 0 are not data for the blend; h is their median).
-  void Set(const ImplicitField& fit, const WindingNumber& winding, const NeighborGrid& grid, const double* supports);
+  /// `fit`, `grid` (the cloud's) and the arrays must outlive this field; `supports` are the fit supports h_i in
+  /// the caller's point order (h, the blend's length, is their median over h_i > 0); points,
+  /// unit normals and areas (3, 3, 1 per point, same order) define the winding number, whose tree is built on
+  /// the first evaluation that needs it (a well-sampled closed cloud may never need it).
+  void Set(const ImplicitField& fit, const NeighborGrid& grid, const double* supports, const double* points,
+    const double* normals, const double* areas, Index count);
+
+  /// The winding number (built on first use; thread-safe).
+  const WindingNumber& Winding() const;
+  bool WindingBuilt() const { return this->Built.load(); }
 
   bool Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& scratch) const override;
 
@@ -47,12 +56,18 @@ public:
 
 private:
   /// t and its gradient.
-  double Blend(const double x[3], double gradient[3], FieldScratch& scratch) const;
+  double Blend(const double x[3], double gradient[3], FieldScratch& scratch, bool fitQueried) const;
+  bool FitQueriesSamples = false;
   const ImplicitField* Fit = nullptr;
-  const WindingNumber* Winding = nullptr;
+  mutable WindingNumber Tree;
+  mutable std::once_flag Once;
+  mutable std::atomic<bool> Built{ false };
+  const double* Points = nullptr;
+  const double* Normals = nullptr;
+  const double* Areas = nullptr;
+  Index Count = 0;
   const NeighborGrid* Grid = nullptr;
-  std::vector<double> InverseSupport; // sorted order; 0 for points that are not data
-  double QueryRadius = 0.0;
+  double InverseScale = 0.0; // 1 / the median support
   double GradientFloor = 0.0;
 };
 

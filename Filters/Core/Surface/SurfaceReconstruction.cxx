@@ -323,8 +323,8 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
 
   std::unique_ptr<ImplicitField> field; // the surface contoured
   std::unique_ptr<ImplicitField> fit;   // MLS/WLS with holes filled: the fits the field continues
-  WindingNumber winding;
   NormalField normals;
+  std::vector<double> areas;
   std::vector<double> support;
   std::vector<std::uint64_t> seeds;
   ContourOptions lattice;
@@ -411,22 +411,28 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       patches->SetCloud(grid, normals.Normals.data(), support.data());
       field = std::move(patches);
     }
-    // The winding number of the samples the fits use: how closed the cloud is, and the continuation of the
-    // fits across the regions without samples (HoleFilling.h).
+    // How closed the cloud is, from the samples the fits use, and the continuation of the fits across the
+    // regions without samples (HoleFilling.h; the winding number's tree is built when first needed).
     const auto fillStart = Clock::now();
-    std::vector<double> areas = SampleAreas(normals.NeighborDistance, options.NeighborCount);
+    areas = SampleAreas(normals.NeighborDistance, options.NeighborCount);
+    double total = 0.0, dipole[3] = { 0.0, 0.0, 0.0 };
     for (size_t i = 0; i < areas.size(); ++i)
     {
       areas[i] = support[i] > 0.0 && !normals.Outlier[i] ? areas[i] : 0.0;
+      total += areas[i];
+      for (int a = 0; a < 3; ++a)
+      {
+        dipole[a] += areas[i] * normals.Normals[3 * i + a];
+      }
     }
-    winding.Build(distinct.Points, normals.Normals.data(), areas.data(), distinct.Count);
-    report.OpenShare = winding.TotalArea() > 0.0 ? winding.DipoleLength() / winding.TotalArea() : 1.0;
+    report.OpenShare =
+      total > 0.0 ? std::sqrt(dipole[0] * dipole[0] + dipole[1] * dipole[1] + dipole[2] * dipole[2]) / total : 1.0;
     report.HolesFilled = options.HoleFilling == HoleFillingMode::On ||
       (options.HoleFilling == HoleFillingMode::Auto && report.OpenShare < options.ClosedBelow);
     if (report.HolesFilled)
     {
       auto filled = std::make_unique<FilledField>();
-      filled->Set(*field, winding, grid, support.data());
+      filled->Set(*field, grid, support.data(), distinct.Points, normals.Normals.data(), areas.data(), distinct.Count);
       fit = std::move(field);
       field = std::move(filled);
     }

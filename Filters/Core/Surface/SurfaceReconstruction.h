@@ -116,7 +116,7 @@ struct SurfaceReport
   Index Pieces = 0;                // connected pieces before the stray ones were removed
   Index RemovedPieces = 0;         // pieces too few samples support
   Index RemovedTriangles = 0;      // their triangles
-  double FillSeconds = 0.0;        // the winding number's tree
+  double FillSeconds = 0.0;        // OpenShare (the winding number's tree is built on first use, while contouring)
   // Wall-clock seconds of the stages: neighbourhoods, normals and the field's set-up; contouring; projection.
   double SetupSeconds = 0.0;
   double ContourSeconds = 0.0;

@@ -39,9 +39,19 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
   {
     return;
   }
-  std::vector<double> xyz(points, points + 3 * count);
+  // The splits move the points themselves (contiguous, cache-friendly), not indices into them.
+  std::vector<Item> items(order.size());
+  for (size_t s = 0; s < order.size(); ++s)
+  {
+    const Index i = order[s];
+    items[s] = Item{ { points[3 * i], points[3 * i + 1], points[3 * i + 2] }, i };
+  }
   this->Nodes.reserve(static_cast<size_t>(2 * (order.size() / kLeafSize + 1)));
-  this->BuildNode(0, static_cast<Index>(order.size()), order, xyz);
+  this->BuildNode(0, static_cast<Index>(items.size()), items);
+  for (size_t s = 0; s < items.size(); ++s)
+  {
+    order[s] = items[s].Id;
+  }
   // Copy the points in tree order (leaves read them contiguously).
   const size_t m = order.size();
   this->Points.resize(3 * m);
@@ -62,55 +72,96 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     this->Soft2[s] = areas[i] / M_PI;
     this->Total += areas[i];
   }
-  // Moments bottom-up (children always follow their parent in this->Nodes).
+  // Moments bottom-up (children always follow their parent in this->Nodes): leaves sum their points, inner
+  // nodes combine their children's moments moved to their own centre (O(n) in all).
   for (size_t k = this->Nodes.size(); k-- > 0;)
   {
     Node& node = this->Nodes[k];
-    double area = 0.0, c[3] = { 0, 0, 0 }, plain[3] = { 0, 0, 0 };
-    for (Index s = node.Begin; s < node.End; ++s)
+    std::fill(node.Moment, node.Moment + 3, 0.0);
+    std::fill(node.Second, node.Second + 9, 0.0);
+    std::fill(node.Third, node.Third + 27, 0.0);
+    double area = 0.0, c[3] = { 0, 0, 0 };
+    if (node.Left < 0)
     {
-      area += this->Areas[s];
+      for (Index s = node.Begin; s < node.End; ++s)
+      {
+        area += this->Areas[s];
+        for (int a = 0; a < 3; ++a)
+        {
+          c[a] += this->Areas[s] * this->Points[3 * s + a];
+        }
+      }
       for (int a = 0; a < 3; ++a)
       {
-        c[a] += this->Areas[s] * this->Points[3 * s + a];
-        plain[a] += this->Points[3 * s + a];
+        node.Centre[a] = c[a] / area;
+      }
+      double r2 = 0.0;
+      for (Index s = node.Begin; s < node.End; ++s)
+      {
+        const double a = this->Areas[s];
+        const double* p = &this->Points[3 * s];
+        const double* n = &this->Normals[3 * s];
+        const double d[3] = { p[0] - node.Centre[0], p[1] - node.Centre[1], p[2] - node.Centre[2] };
+        for (int i = 0; i < 3; ++i)
+        {
+          node.Moment[i] += a * n[i];
+          for (int j = 0; j < 3; ++j)
+          {
+            node.Second[3 * i + j] += a * d[i] * n[j];
+            for (int l = 0; l < 3; ++l)
+            {
+              node.Third[9 * i + 3 * j + l] += a * n[i] * d[j] * d[l];
+            }
+          }
+        }
+        r2 = std::max(r2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      }
+      node.Radius = std::sqrt(r2);
+      node.Area = area;
+      continue;
+    }
+    const Node* children[2] = { &this->Nodes[node.Left], &this->Nodes[node.Right] };
+    for (const Node* child : children)
+    {
+      area += child->Area;
+      for (int a = 0; a < 3; ++a)
+      {
+        c[a] += child->Area * child->Centre[a];
       }
     }
     for (int a = 0; a < 3; ++a)
     {
       node.Centre[a] = c[a] / area;
-      node.Moment[a] = 0.0;
     }
-    std::fill(node.Second, node.Second + 9, 0.0);
-    std::fill(node.Third, node.Third + 27, 0.0);
-    double r2 = 0.0;
-    // Leaves and inner nodes alike sum their points directly: the tree is shallow (log2(n / 8) levels), so
-    // this costs O(n log n) once, and the radius is exact.
-    for (Index s = node.Begin; s < node.End; ++s)
+    node.Area = area;
+    node.Radius = 0.0;
+    for (const Node* child : children)
     {
-      const double a = this->Areas[s];
-      const double* p = &this->Points[3 * s];
-      const double* n = &this->Normals[3 * s];
-      const double d[3] = { p[0] - node.Centre[0], p[1] - node.Centre[1], p[2] - node.Centre[2] };
+      // With d = d_child + e, e = c_child - c: Q = Q_child + e M^T, and
+      // C_abl = C_child,abl + Q_child,ba e_l + e_b Q_child,la + e_b e_l M_a.
+      const double e[3] = { child->Centre[0] - node.Centre[0], child->Centre[1] - node.Centre[1],
+        child->Centre[2] - node.Centre[2] };
+      const double* m = child->Moment;
+      const double* q = child->Second;
       for (int i = 0; i < 3; ++i)
       {
-        node.Moment[i] += a * n[i];
+        node.Moment[i] += m[i];
         for (int j = 0; j < 3; ++j)
         {
-          node.Second[3 * i + j] += a * d[i] * n[j];
-          for (int k = 0; k < 3; ++k)
+          node.Second[3 * i + j] += q[3 * i + j] + e[i] * m[j];
+          for (int l = 0; l < 3; ++l)
           {
-            node.Third[9 * i + 3 * j + k] += a * n[i] * d[j] * d[k];
+            node.Third[9 * i + 3 * j + l] +=
+              child->Third[9 * i + 3 * j + l] + q[3 * j + i] * e[l] + e[j] * q[3 * l + i] + e[j] * e[l] * m[i];
           }
         }
       }
-      r2 = std::max(r2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      node.Radius = std::max(node.Radius, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + child->Radius);
     }
-    node.Radius = std::sqrt(r2);
   }
 }
 
-Index WindingNumber::BuildNode(Index begin, Index end, std::vector<Index>& order, const std::vector<double>& xyz)
+Index WindingNumber::BuildNode(Index begin, Index end, std::vector<Item>& items)
 {
   const Index id = static_cast<Index>(this->Nodes.size());
   this->Nodes.push_back(Node());
@@ -121,14 +172,14 @@ Index WindingNumber::BuildNode(Index begin, Index end, std::vector<Index>& order
   {
     return id;
   }
-  double lo[3] = { xyz[3 * order[begin]], xyz[3 * order[begin] + 1], xyz[3 * order[begin] + 2] };
+  double lo[3] = { items[begin].P[0], items[begin].P[1], items[begin].P[2] };
   double hi[3] = { lo[0], lo[1], lo[2] };
   for (Index s = begin; s < end; ++s)
   {
     for (int a = 0; a < 3; ++a)
     {
-      lo[a] = std::min(lo[a], xyz[3 * order[s] + a]);
-      hi[a] = std::max(hi[a], xyz[3 * order[s] + a]);
+      lo[a] = std::min(lo[a], items[s].P[a]);
+      hi[a] = std::max(hi[a], items[s].P[a]);
     }
   }
   int axis = 0;
@@ -137,10 +188,10 @@ Index WindingNumber::BuildNode(Index begin, Index end, std::vector<Index>& order
     axis = hi[a] - lo[a] > hi[axis] - lo[axis] ? a : axis;
   }
   const Index mid = begin + (end - begin) / 2;
-  std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
-    [&xyz, axis](Index a, Index b) { return xyz[3 * a + axis] < xyz[3 * b + axis]; });
-  const Index left = this->BuildNode(begin, mid, order, xyz);
-  const Index right = this->BuildNode(mid, end, order, xyz);
+  std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+    [axis](const Item& a, const Item& b) { return a.P[axis] < b.P[axis] || (a.P[axis] == b.P[axis] && a.Id < b.Id); });
+  const Index left = this->BuildNode(begin, mid, items);
+  const Index right = this->BuildNode(mid, end, items);
   this->Nodes[id].Left = left;
   this->Nodes[id].Right = right;
   return id;

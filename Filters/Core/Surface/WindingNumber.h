@@ -59,11 +59,17 @@ private:
     double Moment[3];
     double Second[9]; // row-major sum a (p - c) n^T
     double Third[27]; // [a][b][c]: sum area n_a d_b d_c, d = p - c
-    double Radius;
+    double Radius;     // bounds |p - c| over the node's points
+    double Area;
     Index Begin, End;  // points [Begin, End) in this->Points' order
     Index Left, Right; // children (-1 for a leaf)
   };
-  Index BuildNode(Index begin, Index end, std::vector<Index>& order, const std::vector<double>& xyz);
+  struct Item
+  {
+    double P[3];
+    Index Id;
+  };
+  Index BuildNode(Index begin, Index end, std::vector<Item>& items);
   std::vector<Node> Nodes;
   std::vector<double> Points, Normals, Areas, Soft2; // tree order; Soft2: regularisation radius squared
   double Beta2 = 4.0;
