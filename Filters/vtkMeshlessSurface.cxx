@@ -409,7 +409,7 @@ void vtkMeshlessSurface::ReportReconstruction(const Cloud& cloud, const Result& 
         << "border (" << topology.BoundaryEdges
         << " boundary edges). Set HoleFilling to On to close it across the regions without samples.");
     }
-    else if (report.OpenShare < 0.35)
+    else if (report.OpenShare < meshfree::SurfaceOptions().ClosedBelow)
     {
       vtkWarningMacro("The cloud encloses a volume but regions without samples leave the surface open ("
         << topology.BoundaryEdges << " boundary edges): HoleFilling (On or Auto) closes them.");

@@ -151,7 +151,7 @@ public:
    * MLS, WLS: where no sample supports a fit (the unseen underside of a scan), continue the surface from the
    * cloud's generalized winding number, a smooth, tight film blended into the fits (Barill et al. 2018;
    * Filters/Core/Surface/HoleFilling.h). Auto (default) fills when the cloud encloses a volume: its
-   * area-weighted normals nearly cancel (|sum a n| / sum a < 0.35; a flat patch gives 1, a hemisphere 0.5).
+   * area-weighted normals nearly cancel (|sum a n| / sum a < 0.45; a flat patch gives 1, a hemisphere 0.5).
    * Off, or Auto on an open cloud, leaves the surface open, its border within a few spacings of the data's.
    * The point array `DistanceToData` (every method) lets filled parts be cut away with a Threshold.
    */

@@ -116,7 +116,7 @@ std::vector<unsigned char> TrimmedTriangles(const TriangleMesh& mesh, const std:
       }
       const double* x = &mesh.Points[3 * v];
       const double* n = &normals[3 * v];
-      grid.FindWithinRadiusPositions(x, limit[v], b.Positions, b.Dist2);
+      grid.FindWithinRadiusPositions(x, 1.5 * limit[v], b.Positions, b.Dist2);
       double mean[3] = { 0.0, 0.0, 0.0 };
       Index count = 0;
       for (size_t j = 0; j < b.Positions.size(); ++j)
