@@ -32,7 +32,8 @@
  * approximated. No NaN is ever written.
  *
  * Field data: `SurfaceMethod` (text), `CellSize`, `SupportRadius` (median fit support, or the SPH kernel
- * radius H) and the stages' wall-clock seconds (`SetupSeconds`, `ContourSeconds`, `ProjectionSeconds`,
+ * radius H), for MLS and WLS `OpenShare` (|sum a n| / sum a of the samples: 0 closed, 1 flat) and `HolesFilled`
+ * (1 when HoleFilling closed the regions without samples), and the stages' wall-clock seconds (`SetupSeconds`, `ContourSeconds`, `ProjectionSeconds`,
  * `ApproximationSeconds`).
  *
  * Under MPI (pvbatch, pvserver: each rank's input is piece = rank of N) the pieces' outputs together are the
