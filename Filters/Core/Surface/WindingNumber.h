@@ -13,7 +13,7 @@
  * spans the hole like a soap film, without bulging).
  *
  * Barnes-Hut evaluation: a binary tree over the points (median splits along the widest axis, leaves of at most
- * 8 points); every node keeps its area-weighted centre c, its dipole moment M = sum a_i n_i, the second moment
+ * 32 points); every node keeps its area-weighted centre c, its dipole moment M = sum a_i n_i, the second moment
  * Q = sum a_i (p_i - c) n_i^T and its radius r (largest |p_i - c|). A node with |x - c| > Beta r is summed by
  * its Taylor expansion to second order in the points' offsets d = p - c, M . g(r) + tr(J(r) Q) + 1/2 H(r)[C]
  * with r = c - x, g(r) = r / (4 pi |r|^3), J and H its first and second derivatives and C = sum a n (x) d (x) d
