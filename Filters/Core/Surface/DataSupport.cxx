@@ -160,9 +160,9 @@ std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const Neigh
   pieces = TriangleComponents(mesh.Triangles, nv, component);
   removedPieces = 0;
   std::vector<unsigned char> keep(static_cast<size_t>(nt), 1);
-  if (pieces <= 0 || nv == 0)
+  if (pieces <= 1 || nv == 0)
   {
-    return keep;
+    return keep; // one piece is always kept (the best-supported one)
   }
   std::vector<Index> vertexPiece(static_cast<size_t>(nv), -1);
   for (Index t = 0; t < nt; ++t)
