@@ -74,6 +74,7 @@ namespace
 {
 const char* const kNormals = "Normals";
 const char* const kValidMask = "vtkValidPointMask";
+const char* const kDistanceToData = "DistanceToData";
 
 /// Triangles as vtkPolyData: 64-bit offsets and connectivity, double points, unit outward `Normals`.
 void WrapMesh(const meshfree::SurfaceMesh& mesh, vtkPolyData* output)
@@ -105,9 +106,22 @@ void WrapMesh(const meshfree::SurfaceMesh& mesh, vtkPolyData* output)
   normals->SetNumberOfTuples(nv);
   std::copy(mesh.Normals.begin(), mesh.Normals.end(), normals->GetPointer(0));
 
+  vtkNew<vtkDoubleArray> distance;
+  distance->SetName(kDistanceToData);
+  distance->SetNumberOfTuples(nv);
+  if (mesh.DistanceToData.size() == static_cast<size_t>(nv))
+  {
+    std::copy(mesh.DistanceToData.begin(), mesh.DistanceToData.end(), distance->GetPointer(0));
+  }
+  else
+  {
+    distance->Fill(0.0);
+  }
+
   output->SetPoints(points);
   output->SetPolys(polys);
   output->GetPointData()->SetNormals(normals);
+  output->GetPointData()->AddArray(distance);
 }
 
 /// Triangles [begin, end) of `mesh` with the vertices they use, in the order of their indices in `mesh`; `kept`
@@ -131,6 +145,10 @@ meshfree::SurfaceMesh TriangleShare(const meshfree::SurfaceMesh& mesh, vtkIdType
     kept->InsertNextId(static_cast<vtkIdType>(v));
     share.Points.insert(share.Points.end(), &mesh.Points[3 * v], &mesh.Points[3 * v] + 3);
     share.Normals.insert(share.Normals.end(), &mesh.Normals[3 * v], &mesh.Normals[3 * v] + 3);
+    if (mesh.DistanceToData.size() == mesh.Normals.size() / 3)
+    {
+      share.DistanceToData.push_back(mesh.DistanceToData[v]);
+    }
   }
   share.Triangles.reserve(static_cast<size_t>(3 * (end - begin)));
   for (vtkIdType c = 3 * begin; c < 3 * end; ++c)
@@ -194,6 +212,7 @@ void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessControll
     vtkDataArray* array = pd->GetArray(a);
     const char* name = array ? array->GetName() : nullptr;
     if (!name || std::strcmp(name, kNormals) == 0 || std::strcmp(name, kValidMask) == 0 ||
+      std::strcmp(name, kDistanceToData) == 0 ||
       std::strcmp(name, vtkDataSetAttributes::GhostArrayName()) == 0)
     {
       continue;
@@ -359,19 +378,51 @@ void vtkMeshlessSurface::ReportReconstruction(const Cloud& cloud, const Result& 
                                             << ": the lattice would need more than 2^21 cells along an axis.");
   }
   const meshfree::ContourReport& contour = report.Contour;
-  if (contour.UndefinedCorners > 0 || contour.RoundLimitReached || contour.LatticeEdgeReached)
+  // Boundary edges need a pass over the mesh: only where the contouring or the trimming can have left some.
+  const bool maybeOpen = contour.UndefinedCorners > 0 || contour.RoundLimitReached || contour.LatticeEdgeReached ||
+    report.TrimmedTriangles > 0;
+  const meshfree::MeshTopology topology = maybeOpen
+    ? meshfree::ComputeMeshTopology(result.Mesh.Triangles, result.Mesh.NumberOfPoints())
+    : meshfree::MeshTopology();
+  if (contour.RoundLimitReached || contour.LatticeEdgeReached)
   {
-    const meshfree::MeshTopology topology =
-      meshfree::ComputeMeshTopology(result.Mesh.Triangles, result.Mesh.NumberOfPoints());
-    if (topology.BoundaryEdges > 0 || contour.RoundLimitReached || contour.LatticeEdgeReached)
+    vtkWarningMacro("The surface may be incomplete ("
+      << topology.BoundaryEdges << " boundary edges): "
+      << (contour.RoundLimitReached ? "the contouring hit its round limit (a surface over 500 cells across)" : "")
+      << (contour.RoundLimitReached && contour.LatticeEdgeReached ? "; " : "")
+      << (contour.LatticeEdgeReached ? "the surface ran to the edge of the lattice's range" : "")
+      << ". A larger CellSize covers it with fewer cells.");
+  }
+  else if (topology.BoundaryEdges > 0 && this->Method != SPH)
+  {
+    // Say what is true of the data, and advise only what helps.
+    if (report.HolesFilled)
     {
-      vtkWarningMacro("The surface is open: "
-        << topology.BoundaryEdges << " boundary edges (" << contour.UndefinedCorners
-        << " lattice corners had too few points within the fits' support"
-        << (contour.RoundLimitReached ? "; the contouring hit its round limit" : "")
-        << (contour.LatticeEdgeReached ? "; the lattice's range was reached" : "")
-        << "): raise SupportScale or NeighborCount.");
+      vtkWarningMacro("The surface is open (" << topology.BoundaryEdges
+                                              << " boundary edges) although HoleFilling continued it across the "
+                                                 "regions without samples.");
     }
+    else if (this->HoleFilling == HOLE_FILLING_AUTO)
+    {
+      vtkWarningMacro("The cloud is open (its area-weighted normals cancel only to "
+        << report.OpenShare << " of its area; a closed surface's cancel to 0): the surface follows the data's "
+        << "border (" << topology.BoundaryEdges
+        << " boundary edges). Set HoleFilling to On to close it across the regions without samples.");
+    }
+    else if (report.OpenShare < meshfree::SurfaceOptions().ClosedBelow)
+    {
+      vtkWarningMacro("The cloud encloses a volume but regions without samples leave the surface open ("
+        << topology.BoundaryEdges << " boundary edges): HoleFilling (On or Auto) closes them.");
+    }
+  }
+  else if (topology.BoundaryEdges > 0)
+  {
+    vtkWarningMacro("The surface is open: " << topology.BoundaryEdges << " boundary edges.");
+  }
+  if (report.RemovedPieces > 0)
+  {
+    vtkDebugMacro(<< report.RemovedPieces << " of " << report.Pieces << " pieces (" << report.RemovedTriangles
+                  << " triangles) removed: fewer than NeighborCount samples support each.");
   }
   if (result.Mesh.NumberOfTriangles() == 0)
   {
@@ -535,6 +586,7 @@ int vtkMeshlessSurface::RequestData(
   options.Level = this->SurfaceLevel;
   options.Anisotropic = this->AnisotropicKernels;
   options.ProjectVertices = this->ProjectVertices;
+  options.HoleFilling = static_cast<meshfree::HoleFillingMode>(this->HoleFilling);
   Result result;
   std::string error;
   if (!meshfree::ReconstructSurface(in, options, result.Mesh, result.Report, error, vtkMeshFreeFilterSupport::Progress(this, 0.0, 0.9)))
@@ -570,7 +622,8 @@ int vtkMeshlessSurface::RequestData(
     for (int a = 0; a < from->GetNumberOfArrays(); ++a)
     {
       vtkAbstractArray* array = from->GetAbstractArray(a);
-      if (!array->GetName() || std::strcmp(array->GetName(), kNormals) == 0)
+      if (!array->GetName() || std::strcmp(array->GetName(), kNormals) == 0 ||
+        std::strcmp(array->GetName(), kDistanceToData) == 0)
       {
         continue;
       }
@@ -601,6 +654,11 @@ int vtkMeshlessSurface::RequestData(
   fd->AddArray(method);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "CellSize", result.Report.CellSize);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "SupportRadius", result.Report.SupportRadius);
+  if (options.Method != meshfree::SurfaceMethod::SPH)
+  {
+    vtkMeshFreeFilterSupport::AddFieldValue(fd, "OpenShare", result.Report.OpenShare);
+    vtkMeshFreeFilterSupport::AddFieldValue(fd, "HolesFilled", result.Report.HolesFilled ? 1.0 : 0.0);
+  }
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "SetupSeconds", result.Report.SetupSeconds);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "ContourSeconds", result.Report.ContourSeconds);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "ProjectionSeconds", result.Report.ProjectionSeconds);
@@ -621,4 +679,5 @@ void vtkMeshlessSurface::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "AnisotropicKernels: " << this->AnisotropicKernels << "\n";
   os << indent << "ProjectVertices: " << this->ProjectVertices << "\n";
   os << indent << "UseInputNormals: " << this->UseInputNormals << "\n";
+  os << indent << "HoleFilling: " << this->HoleFilling << "\n";
 }

@@ -3,9 +3,10 @@
  * @brief   triangle mesh of the surface a point cloud or a particle fluid samples (ParaView "Meshless Surface")
  *
  * Input port 0 (`Input`) is a point cloud or a set of SPH particles (vtkPointSet). The output is a
- * vtkPolyData of triangles, closed where the sampled object is closed, with the point array `Normals` (unit,
- * outward; also the active normals) and every other numeric point array of the input approximated at the
- * vertices (same names, every component, as double).
+ * vtkPolyData of triangles, closed where the sampled object is closed, with the point arrays `Normals` (unit,
+ * outward; also the active normals) and `DistanceToData` (distance from the vertex to the nearest input point:
+ * 0 on the data, growing across a filled hole), and every other numeric point array of the input approximated
+ * at the vertices (same names, every component, as double).
  *
  * Methods (details in Filters/Core/Surface/SurfaceReconstruction.h):
  * - MLS (default): the algebraic point-set surface (APSS: a sphere fitted at every point of space) of the
@@ -31,7 +32,8 @@
  * approximated. No NaN is ever written.
  *
  * Field data: `SurfaceMethod` (text), `CellSize`, `SupportRadius` (median fit support, or the SPH kernel
- * radius H) and the stages' wall-clock seconds (`SetupSeconds`, `ContourSeconds`, `ProjectionSeconds`,
+ * radius H), for MLS and WLS `OpenShare` (|sum a n| / sum a of the samples: 0 closed, 1 flat) and `HolesFilled`
+ * (1 when HoleFilling closed the regions without samples), and the stages' wall-clock seconds (`SetupSeconds`, `ContourSeconds`, `ProjectionSeconds`,
  * `ApproximationSeconds`).
  *
  * Under MPI (pvbatch, pvserver: each rank's input is piece = rank of N) the pieces' outputs together are the
@@ -138,6 +140,26 @@ public:
   vtkBooleanMacro(ProjectVertices, bool);
   ///@}
 
+  enum HoleFillingModes
+  {
+    HOLE_FILLING_OFF = 0,
+    HOLE_FILLING_ON = 1,
+    HOLE_FILLING_AUTO = 2
+  };
+
+  ///@{
+  /**
+   * MLS, WLS: where no sample supports a fit (the unseen underside of a scan), continue the surface from the
+   * cloud's generalized winding number, a smooth, tight film blended into the fits (Barill et al. 2018;
+   * Filters/Core/Surface/HoleFilling.h). Auto (default) fills when the cloud encloses a volume: its
+   * area-weighted normals nearly cancel (|sum a n| / sum a < 0.45; a flat patch gives 1, a hemisphere 0.5).
+   * Off, or Auto on an open cloud, leaves the surface open, its border within a few spacings of the data's.
+   * The point array `DistanceToData` (every method) lets filled parts be cut away with a Threshold.
+   */
+  vtkSetClampMacro(HoleFilling, int, HOLE_FILLING_OFF, HOLE_FILLING_AUTO);
+  vtkGetMacro(HoleFilling, int);
+  ///@}
+
   ///@{
   /**
    * MLS, WLS: use the input's 3-component point array `Normals` when present (default on); off (or without
@@ -164,6 +186,7 @@ protected:
   bool AnisotropicKernels = false;
   bool ProjectVertices = true;
   bool UseInputNormals = true;
+  int HoleFilling = HOLE_FILLING_AUTO;
 
 private:
   vtkMeshlessSurface(const vtkMeshlessSurface&) = delete;

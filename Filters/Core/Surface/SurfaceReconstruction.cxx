@@ -3,7 +3,9 @@
 #include "Surface/SurfaceReconstruction.h"
 
 #include "Common/Parallel.h"
+#include "Surface/DataSupport.h"
 #include "Surface/FluidSurface.h"
+#include "Surface/HoleFilling.h"
 #include "Surface/PatchSurface.h"
 #include "Surface/PointSetSurface.h"
 #include "Surface/UniqueCloud.h"
@@ -322,7 +324,11 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     grid.Build(distinct.Points, distinct.Count);
   }
 
-  std::unique_ptr<ImplicitField> field;
+  std::unique_ptr<ImplicitField> field; // the surface contoured
+  std::unique_ptr<ImplicitField> fit;   // MLS/WLS with holes filled: the fits the field continues
+  NormalField normals;
+  std::vector<double> areas;
+  std::vector<double> support;
   std::vector<std::uint64_t> seeds;
   ContourOptions lattice;
   lattice.MaximumRounds = options.MaximumRounds;
@@ -365,7 +371,6 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     NormalOptions no;
     no.NeighborCount = options.NeighborCount;
     no.SupportRadius = options.SupportRadius;
-    NormalField normals;
     if (!EstimateNormals(grid, no, normals, Stage(progress, 0.0, 0.15)) && progress && !progress(0.15))
     {
       report.Aborted = true;
@@ -383,7 +388,7 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       report.Orientation = OrientNormals(grid, normals, OrientationOptions(), confidence);
       report.PointsWithoutNormal = normals.InvalidCount - grid.NumberOfInvalidPoints();
     }
-    std::vector<double> support = FitSupports(
+    support = FitSupports(
       normals, options.SupportScale, options.NoiseScale, options.SupportRadius > 0.0, report.SupportRadius);
     if (!(cell > 0.0))
     {
@@ -409,6 +414,32 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       patches->SetCloud(grid, normals.Normals.data(), support.data());
       field = std::move(patches);
     }
+    // How closed the cloud is, from the samples the fits use, and the continuation of the fits across the
+    // regions without samples (HoleFilling.h; the winding number's tree is built when first needed).
+    const auto fillStart = Clock::now();
+    areas = SampleAreas(normals.NeighborDistance, options.NeighborCount);
+    double total = 0.0, dipole[3] = { 0.0, 0.0, 0.0 };
+    for (size_t i = 0; i < areas.size(); ++i)
+    {
+      areas[i] = support[i] > 0.0 && !normals.Outlier[i] ? areas[i] : 0.0;
+      total += areas[i];
+      for (int a = 0; a < 3; ++a)
+      {
+        dipole[a] += areas[i] * normals.Normals[3 * i + a];
+      }
+    }
+    report.OpenShare =
+      total > 0.0 ? std::sqrt(dipole[0] * dipole[0] + dipole[1] * dipole[1] + dipole[2] * dipole[2]) / total : 1.0;
+    report.HolesFilled = options.HoleFilling == HoleFillingMode::On ||
+      (options.HoleFilling == HoleFillingMode::Auto && report.OpenShare < options.ClosedBelow);
+    if (report.HolesFilled)
+    {
+      auto filled = std::make_unique<FilledField>();
+      filled->Set(*field, grid, support.data(), distinct.Points, normals.Normals.data(), areas.data(), distinct.Count);
+      fit = std::move(field);
+      field = std::move(filled);
+    }
+    report.FillSeconds = seconds(fillStart);
     std::vector<unsigned char> seeding(normals.Valid);
     for (size_t i = 0; i < seeding.size(); ++i)
     {
@@ -438,6 +469,46 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   report.ContourSeconds = seconds(start);
   start = Clock::now();
   report.ProjectedVertices = ProjectVertices(*field, lattice.CellSize, options.ProjectVertices, mesh);
+  std::vector<Index> nearest;
+  DistanceToData(grid, mesh.Points, mesh.DistanceToData, nearest);
+  if (options.Method != SurfaceMethod::SPH)
+  {
+    // How far from a sample the surface still counts as on the data: TrimSpacings local spacings (from the
+    // sample's r_k) and the noise's spread.
+    const double k = static_cast<double>(options.NeighborCount);
+    const double noise = 3.0 * report.Scale.Noise;
+    std::vector<double> limit(normals.NeighborDistance.size(), 0.0), nearLimit(limit.size(), 0.0);
+    for (size_t i = 0; i < limit.size(); ++i)
+    {
+      const double rk = normals.NeighborDistance[i];
+      const double spacing = rk > 0.0 && std::isfinite(rk) ? rk * std::sqrt(M_PI / k) : report.Scale.Spacing;
+      const double reach = options.TrimSpacings * spacing;
+      limit[i] = std::sqrt(reach * reach + noise * noise);
+      nearLimit[i] = std::sqrt(spacing * spacing + noise * noise);
+    }
+    const std::vector<VertexAttribute> attributes = { { &mesh.Normals, 3 }, { &mesh.DistanceToData, 1 } };
+    if (!report.HolesFilled && options.TrimSpacings > 0.0)
+    {
+      // On the data: within one local spacing (and the noise) of a sample, or within the limit and surrounded
+      // by samples (DataSupport.h).
+      std::vector<double> vertexLimit(nearest.size(), 0.0), vertexNear(nearest.size(), 0.0);
+      for (size_t v = 0; v < nearest.size(); ++v)
+      {
+        vertexLimit[v] = nearest[v] >= 0 ? limit[nearest[v]] : 0.0;
+        vertexNear[v] = nearest[v] >= 0 ? nearLimit[nearest[v]] : 0.0;
+      }
+      report.TrimmedTriangles = KeepTriangles(
+        mesh, TrimmedTriangles(mesh, mesh.Normals, grid, mesh.DistanceToData, vertexNear, vertexLimit), attributes);
+    }
+    if (options.RemoveStrayPieces && mesh.NumberOfTriangles() > 0)
+    {
+      const Index before = mesh.NumberOfTriangles();
+      const std::vector<unsigned char> keep = SupportedPieces(
+        mesh, grid, limit, std::min<Index>(options.NeighborCount, grid.NumberOfValidPoints()), report.Pieces, report.RemovedPieces);
+      KeepTriangles(mesh, keep, attributes);
+      report.RemovedTriangles = before - mesh.NumberOfTriangles();
+    }
+  }
   report.ProjectionSeconds = seconds(start);
   if (progress && !progress(1.0))
   {

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class meshfree::WindingNumber
+ * @brief The generalized winding number of an oriented point cloud, a smooth global inside/outside estimate
+ *        (Barill, Dickson, Schmidt, Levin & Jacobson 2018, "Fast winding numbers for soups and clouds").
+ *
+ * Every point p_i carries an area a_i and a unit outward normal n_i; the cloud's winding number at x is
+ *
+ *   w(x) = sum_i a_i n_i . (p_i - x) / (4 pi |p_i - x|^3),
+ *
+ * the solid angle the sampled surface subtends at x over 4 pi: about 1 inside a closed sampled surface, 0
+ * outside, and across a hole in the sampling a smooth, harmonic interpolation between the two (its 1/2 level
+ * spans the hole like a soap film, without bulging).
+ *
+ * Barnes-Hut evaluation: a binary tree over the points (median splits along the widest axis, leaves of at most
+ * 32 points); every node keeps its area-weighted centre c, its dipole moment M = sum a_i n_i, the second moment
+ * Q = sum a_i (p_i - c) n_i^T and its radius r (largest |p_i - c|). A node with |x - c| > Beta r is summed by
+ * its Taylor expansion to second order in the points' offsets d = p - c, M . g(r) + tr(J(r) Q) + 1/2 H(r)[C]
+ * with r = c - x, g(r) = r / (4 pi |r|^3), J and H its first and second derivatives and C = sum a n (x) d (x) d
+ * (the normals vary within a node as much as the points do, so the H term is of the same order as the Q term:
+ * without it the expansion was worse than the first order alone, 8.7 % against 2.9 % at a sphere's centre);
+ * nearer nodes are opened, leaves summed directly. The gradient uses the first-order term. The
+ * direct terms are regularised within sqrt(a_i / pi) of a point (the disc it stands for), so w stays finite on
+ * the data. Cost per evaluation O(log n) for points far from the data, a few leaves more near them.
+ */
+#ifndef meshfree_WindingNumber_h
+#define meshfree_WindingNumber_h
+
+#include "Common/NeighborGrid.h"
+
+#include <vector>
+
+namespace meshfree
+{
+
+class WindingNumber
+{
+public:
+  /// Points (3 per point), unit outward normals (3 per point) and areas (1 per point); points with a zero or
+  /// non-finite normal, area or coordinate are left out. Beta >= 1 is the opening criterion (default 2).
+  void Build(const double* points, const double* normals, const double* areas, Index count, double beta = 2.0);
+
+  /// w(x); when gradient is not null, grad w(x) (first order in the far nodes).
+  double Evaluate(const double x[3], double gradient[3] = nullptr) const;
+
+  /// The exact sum over every point (O(n), for tests).
+  double EvaluateDirect(const double x[3]) const;
+
+  Index NumberOfPoints() const { return static_cast<Index>(this->Areas.size()); }
+  /// sum a_i and |sum a_i n_i|: a closed surface's normals cancel (its integral of n dA is 0), so their
+  /// ratio is the share of the sampled area left uncovered by holes, as seen through their flat projection.
+  double TotalArea() const { return this->Total; }
+  double DipoleLength() const;
+
+private:
+  struct Node
+  {
+    double Centre[3];
+    double Moment[3];
+    double Second[9]; // row-major sum a (p - c) n^T
+    double Third[27]; // [a][b][c]: sum area n_a d_b d_c, d = p - c
+    double Radius;     // bounds |p - c| over the node's points
+    double Area;
+    Index Begin, End;  // points [Begin, End) in this->Points' order
+    Index Left, Right; // children (-1 for a leaf)
+  };
+  struct Item
+  {
+    double P[3];
+    Index Id;
+  };
+  Index BuildNode(Index begin, Index end, std::vector<Item>& items);
+  std::vector<Node> Nodes;
+  std::vector<double> Points, Normals, Areas, Soft2; // tree order; Soft2: regularisation radius squared
+  double Beta2 = 4.0;
+  double Total = 0.0;
+};
+
+} // namespace meshfree
+
+#endif
