@@ -14,8 +14,8 @@ OUT_DIR/NAME.json (counts, bounding box, mean spacing, the files used). numpy on
 
 Where the files come from (Stanford 3D Scanning Repository, http://graphics.stanford.edu/data/3Dscanrep/, Stanford
 Computer Graphics Laboratory; bunny: Turk & Levoy 1994, Cyberware 3030 MS, 10 views, 362,272 points, zippered
-reconstruction bun_zipper.ply 35,947 vertices / 69,451 triangles; dragon: Curless & Levoy 1996, Cyberware 3030 MS
-with spacetime analysis, reconstruction by VRIP), as copies kept in public GitHub repositories (see
+reconstruction bun_zipper.ply 35,947 vertices / 69,451 triangles; dragon: Cyberware 3030 MS
+with spacetime analysis, reconstruction by VRIP, Curless & Levoy 1996), as copies kept in public GitHub repositories (see
 results/scans.md for the commits and the terms of use):
   bunny views + bun.conf  github.com/somanshu25/GPU-Accelerated-Point-Cloud-Registration-Using-Hierarchical-GMM
                           data/*.ply, data/bun.conf (identical, up to line ends, to bunny.tar.gz's bunny/data)
