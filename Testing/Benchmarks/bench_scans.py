@@ -62,7 +62,7 @@ PROBE = r"""
 import json, sys
 from paraview import simple
 simple.LoadPlugin(sys.argv[1], remote=False)
-src = simple.PolyPointSource()
+src = simple.Sphere()
 f = simple.MeshlessSurface(Input=src)
 print(json.dumps(dict(properties=[str(p) for p in f.ListProperties()])))
 """
