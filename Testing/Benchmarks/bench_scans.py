@@ -93,6 +93,10 @@ benchmark reads them from the folder given on its command line.
 """
 
 
+REFERENCE_NAMES = {"bunny_ref.npz": "bun_zipper.ply, the authors' zippered reconstruction",
+                   "dragon_ref.npz": "the authors' VRIP reconstruction at its res3 decimation (coarse, see Data)"}
+
+
 def log(*args):
     print(*args, flush=True)
 
@@ -313,7 +317,8 @@ def write_report(out, rows, header):
     lines = list(header)
     for case_name in dict.fromkeys(r["case"] for r in rows):
         rs = [r for r in rows if r["case"] == case_name]
-        c = rs[0]
+        c = dict(rs[0])
+        c["reference"] = REFERENCE_NAMES.get(c["reference"], c["reference"])
         lines += ["", "### %s" % c["label"], "",
                   "%d points, spacing %.2e, delta %.2e; reference: %s." % (c["n"], c["spacing"], c["delta"], c["reference"]),
                   "",
@@ -352,6 +357,9 @@ def main():
     ap.add_argument("--note", default="", help="a line for the report's header (e.g. the machine's state)")
     ap.add_argument("--merge", action="store_true",
                     help="keep the rows of OUT/scans_runs.json that this run does not redo (runs add up)")
+    ap.add_argument("--merge-from", action="append", default=[],
+                    help="also keep the rows of this scans_runs.json (another run's) that this run does not redo")
+    ap.add_argument("--report-only", action="store_true", help="run nothing: rewrite OUT/scans.md from the rows kept")
     a = ap.parse_args()
     env = {k: v for k, v in os.environ.items() if not k.startswith("OMP_")}
     env["OMP_WAIT_POLICY"] = "passive"
@@ -364,21 +372,28 @@ def main():
     if a.cases:
         wanted = a.cases.split(",")
         cases = [c for c in cases if c["name"] in wanted]
-    if not cases:
+    if not cases and not a.report_only:
         log("bench_scans: no cases (give --data and/or --virtual; see --help)")
         return 1
     os.makedirs(a.work, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
-    props = probe_meshfree(env) if "meshfree" in tools else None
-    if "meshfree" in tools:
+    props = probe_meshfree(env) if "meshfree" in tools and not a.report_only else None
+    if "meshfree" in tools and not a.report_only:
         log("MeshFree plugin %s: %s" % (plugin_path(), "HoleFilling present" if props and "HoleFilling" in props
                                          else ("loaded, no HoleFilling" if props else "not available")))
     started = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     rows, kept = [], []
     runs_json = os.path.join(a.out, "scans_runs.json")
-    if a.merge and os.path.exists(runs_json):
-        kept = json.load(open(runs_json))["rows"]
-        started = json.load(open(runs_json)).get("started", started) + " and " + started
+    sources = ([runs_json] if a.merge and os.path.exists(runs_json) else []) + a.merge_from
+    if sources:
+        starts = []
+        for src in sources:
+            earlier = json.load(open(src))
+            kept += earlier["rows"]
+            starts.append(earlier.get("started", "?"))
+        started = " and ".join(starts + ([] if a.report_only else [started]))
+    if a.report_only:
+        cases = []
     for case in cases:
         write_inputs(case, a.work)
         case["spacing"] = spacing(case["points"])
@@ -386,7 +401,8 @@ def main():
         delta = 0.004 * float(np.linalg.norm(hi - lo))
         ref = reference_for(case)
         refname = ("the exact surface (%s)" % ", ".join(s["type"] for s in case["spec"]["shapes"])
-                   if case["kind"] == "virtual" else os.path.basename(case["ref"]))
+                   if case["kind"] == "virtual" else REFERENCE_NAMES.get(os.path.basename(case["ref"]),
+                                                                       os.path.basename(case["ref"])))
         for tool, setting, commands, out in tool_runs(case, tools, a.work, props, env):
             if os.path.exists(out):
                 os.unlink(out)
@@ -414,13 +430,18 @@ def main():
     if kept:
         redone = {(r["case"], r["tool"], r["setting"]) for r in rows}
         rows = [r for r in kept if (r["case"], r["tool"], r["setting"]) not in redone] + rows
-        order = {c["name"]: i for i, c in enumerate(cases)}
-        rows.sort(key=lambda r: (order.get(r["case"], -1), r["tool"] != "MeshFree"))
+        order = {}
+        for r in rows:
+            order.setdefault(r["case"], len(order))
+        tools = ["MeshFree", "PCL", "MeshLab", "CGAL", "VTK"]
+        rows.sort(key=lambda r: (order[r["case"]], tools.index(r["tool"]) if r["tool"] in tools else 9))
+        with open(runs_json, "w") as f:
+            json.dump(dict(started=started, rows=rows), f, indent=1, default=str)
     versions = subprocess.run(["dpkg-query", "-W", "-f", "${Package} ${Version}; ", "pcl-tools", "libcgal-dev",
                                "meshlab", "paraview"], capture_output=True, text=True).stdout
     head = subprocess.run(["git", "-C", SOURCE, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     header = ["## Scan benchmark results (bench_scans.py, issue 23)", "",
-              "Run %s on %s (%d cores), MeshFree at commit %s, peers: %s" % (started, platform.node() or "this machine",
+              "Run %s on %s (%d cores), benchmark scripts at commit %s (see the note below for the plugin), peers: %s" % (started, platform.node() or "this machine",
                                                                          os.cpu_count() or 0, head or "?", versions),
               "Environment: OMP_WAIT_POLICY=passive, VTK_SMP_BACKEND_IN_USE=%s; 1-minute load averages before the "
               "runs: %s." % (env["VTK_SMP_BACKEND_IN_USE"], ", ".join("%.1f" % r["load1"] for r in rows)),
