@@ -358,7 +358,8 @@ def main():
     ap.add_argument("--merge", action="store_true",
                     help="keep the rows of OUT/scans_runs.json that this run does not redo (runs add up)")
     ap.add_argument("--merge-from", action="append", default=[],
-                    help="also keep the rows of this scans_runs.json (another run's) that this run does not redo")
+                    help="also keep the rows of this scans_runs.json (another run's) that this run does not redo; "
+                         "where several sources have the same case, tool and setting, the last one given wins")
     ap.add_argument("--report-only", action="store_true", help="run nothing: rewrite OUT/scans.md from the rows kept")
     a = ap.parse_args()
     env = {k: v for k, v in os.environ.items() if not k.startswith("OMP_")}
@@ -392,6 +393,10 @@ def main():
             kept += earlier["rows"]
             starts.append(earlier.get("started", "?"))
         started = " and ".join(starts + ([] if a.report_only else [started]))
+        latest = {}  # the same case, tool and setting in several sources: the later source's row
+        for r in kept:
+            latest[(r["case"], r["tool"], r["setting"])] = r
+        kept = list(latest.values())
     if a.report_only:
         cases = []
     for case in cases:
