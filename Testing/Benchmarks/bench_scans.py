@@ -275,7 +275,7 @@ def border_p99(points, triangles, data_tree, h):
     edges, counts = np.unique(e, axis=0, return_counts=True)
     b = np.unique(edges[counts == 1])
     if len(b) == 0:
-        return 0.0
+        return None  # no border
     d, _ = data_tree.query(v[b])
     return float(np.percentile(d, 99) / h)
 
@@ -333,7 +333,7 @@ def write_report(out, rows, header):
                 r["tool"], r["setting"], fmt(r.get("rms")), fmt(r.get("p99")), fmt(r.get("max")),
                 fmt(r.get("scored_share"), "%.3f"), fmt(r.get("cov_rms")), fmt(r.get("cov_p99")),
                 fmt(r.get("cov_far_share"), "%.4f"), fmt(r.get("boundary_edges")), fmt(r.get("pieces")),
-                fmt(r.get("stray_triangles")), fmt(r.get("euler")), fmt(r.get("border_p99_h"), "%.1f"),
+                fmt(r.get("stray_triangles")), fmt(r.get("euler")), fmt(r.get("border_p99_h") if r.get("boundary_edges") else None, "%.1f"),
                 fmt(r.get("triangles")), fmt(r.get("wall_s"), "%.1f"), fmt(r.get("algo_s"), "%.1f"),
                 fmt(r.get("peak_mb"), "%.0f")))
         notes = [r for r in rs if r.get("notes")]
