@@ -178,12 +178,14 @@ def topology(points, triangles):
     edges, counts = np.unique(e, axis=0, return_counts=True)
     n = len(v)
     graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
-    pieces, label = connected_components(graph, directed=False)
+    _, label = connected_components(graph, directed=False)
+    used = np.unique(t)  # vertices no triangle uses count neither as vertices nor as pieces
     tri_label = label[t[:, 0]]
     largest = np.bincount(tri_label).max() if len(t) else 0
-    return dict(vertices=int(n), triangles=int(len(t)), edges=int(len(edges)),
+    return dict(vertices=int(len(used)), triangles=int(len(t)), edges=int(len(edges)),
                 boundary_edges=int((counts == 1).sum()), nonmanifold_edges=int((counts > 2).sum()),
-                euler=int(n - len(edges) + len(t)), pieces=int(pieces), stray_triangles=int(len(t) - largest))
+                euler=int(len(used) - len(edges) + len(t)), pieces=int(len(np.unique(label[used]))),
+                stray_triangles=int(len(t) - largest))
 
 
 def _stats(d, prefix=""):
