@@ -7,10 +7,10 @@ the scanners never saw a band at the bottom of the inner side). Pictures:
   scan_points.png    the cloud with its estimated, outward normals as glyphs, coloured by intensity
   scan_surface.png   the surface (normals estimated from the points alone), coloured by the scan's intensity
                      approximated onto its vertices. The band the scanners never saw is wider than the default
-                     support (2 x the distance to the 20th neighbour): with the defaults the surface stays open
-                     there, with a warning. A wider support (NeighborCount 30, SupportScale 3) bridges it, and
-                     the WLS method (a quadric per patch) bridges it smoothly where MLS's spheres, fitted to the
-                     band's two rims, bulge out.
+                     support (2 x the distance to the 20th neighbour); HoleFilling (Auto, the default: the cloud
+                     encloses a volume) closes it from the points' winding number, so every method gives one closed
+                     piece (DistanceToData on the vertices tells the filled part). The demo uses WLS with a wider
+                     support (NeighborCount 30, SupportScale 3), which bridges the band smoothly from the data.
 """
 import argparse
 import os
