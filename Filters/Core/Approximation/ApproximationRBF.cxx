@@ -430,10 +430,6 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
       if (rbf.Kept[i])
       {
         kept.push_back(i);
-        for (int a = 0; a < 3; ++a)
-        {
-          centre[a] += coords[3 * i + a];
-        }
       }
     }
     const Index nk = static_cast<Index>(kept.size());
@@ -441,6 +437,18 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
     {
       this->Err = "the cloud has no valid point";
       return false;
+    }
+    // The system's rows by position (then index), and the centroid summed in that order: the fit does not
+    // depend on the order of the points in the input.
+    std::sort(kept.begin(), kept.end(), [coords](Index a, Index b) {
+      return NeighborGrid::NeighborBefore(0.0, coords + 3 * a, a, 0.0, coords + 3 * b, b);
+    });
+    for (Index i : kept)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        centre[a] += coords[3 * i + a];
+      }
     }
     for (double& v : centre)
     {
@@ -533,14 +541,14 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
           chosen.emplace_back(s.Dist2[j], s.Ids[j]);
         }
       }
+      // The nearest `cap` by the grid's neighbour order (distance, then position), in that order: the fit
+      // depends neither on how the points were found nor on their order in the input.
       if (static_cast<int>(chosen.size()) > cap)
       {
-        std::nth_element(chosen.begin(), chosen.begin() + (cap - 1), chosen.end());
+        std::nth_element(chosen.begin(), chosen.begin() + (cap - 1), chosen.end(), this->NeighborOrder());
         chosen.resize(cap);
       }
-      // By id: the fit does not depend on how the points were found.
-      std::sort(chosen.begin(), chosen.end(),
-        [](const std::pair<double, Index>& a, const std::pair<double, Index>& b) { return a.second < b.second; });
+      std::sort(chosen.begin(), chosen.end(), this->NeighborOrder());
       Patch& p = patches[static_cast<size_t>(node)];
       const Index m = static_cast<Index>(chosen.size());
       std::copy(x, x + 3, p.Fit.Origin);
