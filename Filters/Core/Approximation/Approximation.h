@@ -297,6 +297,11 @@ private:
   PointResult SPHPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult PUPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const;
+  /// The partition of unity's last step (3.16-3.21), shared by PU-WLS and RBF-PU: the blended values
+  /// sum(theta L) / sum(theta) and gradients of output point i from the sums (sumGrad and sumDTheta in the
+  /// frame's local coordinates); false when one is not finite. sumTheta must be > 0.
+  bool WriteBlend(Index i, const double* sumValues, const double* sumGrad, const double* sumDTheta, double sumTheta,
+    const ApproximationOutput& out) const;
   /// RBF (ApproximationRBF.cxx): Auto's choice for the cloud (SetCloud), the duplicates' merge and the global
   /// fit or the RBF-PU patches that blend into the m points xyz; the evaluation at one point.
   void ResolveAuto(Index globalValid, int dimension);

@@ -296,6 +296,15 @@ Approximator::PointResult Approximator::PUPoint(
   {
     return result;
   }
+  result.Valid = this->WriteBlend(i, sumValues, sumGrad, sumDTheta, sumTheta, out);
+  return result;
+}
+
+bool Approximator::WriteBlend(Index i, const double* sumValues, const double* sumGrad, const double* sumDTheta,
+  double sumTheta, const ApproximationOutput& out) const
+{
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
   bool finite = true;
   for (int q = 0; q < C; ++q)
   {
@@ -305,7 +314,7 @@ Approximator::PointResult Approximator::PUPoint(
     {
       out.Values[i * C + q] = f;
     }
-    if (gradient)
+    if (out.Gradients)
     {
       // grad (sum theta L / sum theta) = (sum grad(theta L) - f sum grad theta) / sum theta (3.21).
       double l[3] = { 0, 0, 0 };
@@ -318,8 +327,7 @@ Approximator::PointResult Approximator::PUPoint(
       finite = finite && std::isfinite(g[0]) && std::isfinite(g[1]) && std::isfinite(g[2]);
     }
   }
-  result.Valid = finite;
-  return result;
+  return finite;
 }
 
 } // namespace meshfree

@@ -720,27 +720,7 @@ Approximator::PointResult Approximator::RBFPoint(
   {
     return result;
   }
-  for (int q = 0; q < C; ++q)
-  {
-    const double f = sumValues[q] / sumTheta;
-    finite = finite && std::isfinite(f);
-    if (out.Values)
-    {
-      out.Values[i * C + q] = f;
-    }
-    if (gradient)
-    {
-      double l[3] = { 0, 0, 0 };
-      for (int a = 0; a < D; ++a)
-      {
-        l[a] = (sumGrad[a * C + q] - f * sumDTheta[a]) / sumTheta;
-      }
-      double* g = out.Gradients + 3 * (i * C + q);
-      this->Frame.Unproject(l, g);
-      finite = finite && std::isfinite(g[0]) && std::isfinite(g[1]) && std::isfinite(g[2]);
-    }
-  }
-  result.Valid = finite;
+  result.Valid = this->WriteBlend(i, sumValues, sumGrad, sumDTheta, sumTheta, out);
   return result;
 }
 
