@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "Parallel/vtkMeshFreePieces.h"
+#include "vtkMeshFreePieces.h"
 
 #include "vtkCommunicator.h"
 #include "vtkDataArray.h"

@@ -22,7 +22,7 @@
 #include "vtkStringArray.h"
 #include "vtkTypeInt64Array.h"
 
-#include "Parallel/vtkMeshFreePieces.h"
+#include "vtkMeshFreePieces.h"
 
 #include "Approximation/Approximation.h"
 #include "Surface/MeshTopology.h"

@@ -15,7 +15,7 @@
 #include "vtkStringArray.h"
 #include "vtkFieldData.h"
 
-#include "Parallel/vtkMeshFreePieces.h"
+#include "vtkMeshFreePieces.h"
 #include "SPH/SPHFluid.h"
 #include "Common/Parallel.h"
 #include "Common/StateCache.h"

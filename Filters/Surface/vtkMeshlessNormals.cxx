@@ -17,7 +17,7 @@
 #include "vtkPoints.h"
 #include "vtkSmartPointer.h"
 
-#include "Parallel/vtkMeshFreePieces.h"
+#include "vtkMeshFreePieces.h"
 
 #include "Common/Statistics.h"
 #include "Surface/CloudNormals.h"

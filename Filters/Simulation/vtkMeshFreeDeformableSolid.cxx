@@ -15,7 +15,7 @@
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
-#include "Parallel/vtkMeshFreePieces.h"
+#include "vtkMeshFreePieces.h"
 #include "Elastic/ElasticShapes.h"
 #include "Elastic/ElasticSolid.h"
 #include "Common/StateCache.h"
