@@ -333,7 +333,7 @@ bool Approximator::EvaluateAt(const double* xyz, const ImageGeometry* image, Ind
         return false;
     }
   }
-  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  PerThread<FitScratch> scratch;
   struct Counts
   {
     Index Masked = 0;
@@ -360,7 +360,7 @@ bool Approximator::EvaluateAt(const double* xyz, const ImageGeometry* image, Ind
       this->Opts.Method == ApproximationMethod::LS || this->Opts.Method == ApproximationMethod::WLS;
     const Counts counts = ParallelReduce(end - begin, global ? 1024 : 64, Counts(),
       [&](Index b0, Index b1) {
-        FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+        FitScratch& s = scratch.Local();
         // Each block starts without the previous query's neighbour radius: the warm start may list the same
         // neighbours in another order, so a block's sums must not depend on which thread ran which block before.
         s.RadiusGuess = 0.0;

@@ -157,9 +157,9 @@ bool Approximator::PreparePU(const double* xyz, Index count)
   std::vector<double> supports(nodes), conditions(nodes), coefficients(stride * nodes);
   std::vector<int> degrees(nodes, -1), fitCounts(nodes, 0);
 
-  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  PerThread<FitScratch> scratch;
   ParallelFor(nodes, 16, [&](Index begin, Index end) {
-    FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+    FitScratch& s = scratch.Local();
     for (Index node = begin; node < end; ++node)
     {
       const double* x = &centers[3 * node];

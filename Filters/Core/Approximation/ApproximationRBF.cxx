@@ -511,10 +511,10 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
     bool Ok = false;
   };
   std::vector<Patch> patches(static_cast<size_t>(nodeCount));
-  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  PerThread<FitScratch> scratch;
   const int cap = kRBFPatchCap * k;
   ParallelFor(nodeCount, 4, [&](Index begin, Index end) {
-    FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+    FitScratch& s = scratch.Local();
     std::vector<std::pair<double, Index>> chosen;
     std::vector<double> f;
     for (Index node = begin; node < end; ++node)

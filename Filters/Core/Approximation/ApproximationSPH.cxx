@@ -50,9 +50,9 @@ bool Approximator::PrepareSPHVolumes()
   // Fixed blocks of points, each starting without the previous query's neighbour radius (the warm start may
   // list the same neighbours in another order): the sums do not depend on which thread ran which block before.
   constexpr Index block = 256;
-  std::vector<FitScratch> scratch(static_cast<size_t>(MaxThreads()));
+  PerThread<FitScratch> scratch;
   ParallelFor((nv + block - 1) / block, 1, [&](Index b0, Index b1) {
-    FitScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+    FitScratch& s = scratch.Local();
     for (Index p = b0 * block; p < std::min(nv, b1 * block); ++p)
     {
       if (p % block == 0)

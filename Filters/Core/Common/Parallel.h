@@ -35,6 +35,31 @@ int ThreadIndex();
 /// Describes what runs loops, e.g. "oneTBB, 2 threads".
 const char* ParallelBackend();
 
+/// Per-thread scratch: one T for each thread slot, made once before a parallel loop; inside the loop's body
+/// Local() is the calling thread's own (no allocation per item, nothing shared between threads). Iterating
+/// visits every slot (e.g. to merge per-thread results after the loop).
+template <class T>
+class PerThread
+{
+public:
+  PerThread()
+    : Slots(static_cast<std::size_t>(MaxThreads()))
+  {
+  }
+  explicit PerThread(const T& prototype)
+    : Slots(static_cast<std::size_t>(MaxThreads()), prototype)
+  {
+  }
+  T& Local() { return this->Slots[static_cast<std::size_t>(ThreadIndex())]; }
+  std::size_t size() const { return this->Slots.size(); }
+  T& operator[](std::size_t slot) { return this->Slots[slot]; }
+  typename std::vector<T>::iterator begin() { return this->Slots.begin(); }
+  typename std::vector<T>::iterator end() { return this->Slots.end(); }
+
+private:
+  std::vector<T> Slots;
+};
+
 namespace detail
 {
 using RangeFunction = void (*)(void* body, Index begin, Index end);

@@ -46,13 +46,13 @@ void ElasticSolid::AddContactForces(const double* x, std::vector<double>& f)
     }
   }
   this->ContactGrid.Build(this->ContactPositions.data(), m, reach);
-  std::vector<std::vector<Index>> idsPerThread(MaxThreads());
-  std::vector<std::vector<double>> d2PerThread(MaxThreads());
+  PerThread<std::vector<Index>> idsPerThread;
+  PerThread<std::vector<double>> d2PerThread;
   ParallelFor(
     m, 256,
     [&](Index begin, Index end) {
-      std::vector<Index>& ids = idsPerThread[ThreadIndex()];
-      std::vector<double>& d2 = d2PerThread[ThreadIndex()];
+      std::vector<Index>& ids = idsPerThread.Local();
+      std::vector<double>& d2 = d2PerThread.Local();
       for (Index s = begin; s < end; ++s)
       {
         const Index i = this->SurfacePhyxels[s];

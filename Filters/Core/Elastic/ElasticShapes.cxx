@@ -316,13 +316,13 @@ void ElasticSurface::Bind(const ElasticSolid& solid, const std::vector<double>& 
   }
   NeighborGrid grid;
   grid.Build(solid.RestPositions().data(), np);
-  std::vector<std::vector<Index>> idsPerThread(MaxThreads());
-  std::vector<std::vector<double>> d2PerThread(MaxThreads());
+  PerThread<std::vector<Index>> idsPerThread;
+  PerThread<std::vector<double>> d2PerThread;
   ParallelFor(
     nv, 256,
     [&](Index begin, Index end) {
-      std::vector<Index>& ids = idsPerThread[ThreadIndex()];
-      std::vector<double>& d2 = d2PerThread[ThreadIndex()];
+      std::vector<Index>& ids = idsPerThread.Local();
+      std::vector<double>& d2 = d2PerThread.Local();
       for (Index v = begin; v < end; ++v)
       {
         const int found = grid.FindKNearest(&this->RestVertices[3 * v], this->K, ids, d2);

@@ -86,13 +86,13 @@ bool ElasticSolid::Initialize(
   {
     NeighborGrid grid;
     grid.Build(rest.data(), n);
-    std::vector<std::vector<Index>> idsPerThread(MaxThreads());
-    std::vector<std::vector<double>> d2PerThread(MaxThreads());
+    PerThread<std::vector<Index>> idsPerThread;
+    PerThread<std::vector<double>> d2PerThread;
     ParallelFor(
       n, 256,
       [&](Index begin, Index end) {
-        std::vector<Index>& ids = idsPerThread[ThreadIndex()];
-        std::vector<double>& d2 = d2PerThread[ThreadIndex()];
+        std::vector<Index>& ids = idsPerThread.Local();
+        std::vector<double>& d2 = d2PerThread.Local();
         for (Index i = begin; i < end; ++i)
         {
           const int found = grid.FindKNearest(&rest[3 * i], kWanted + 1, ids, d2);

@@ -150,11 +150,11 @@ void SPHFluid::ComputeAccelerations(SPHState& state)
       ParallelThreshold);
     double* pbTerm = this->BoundaryPressureTerm.data();
     const char* active = this->BoundaryActive.data();
-    std::vector<std::vector<Index>> threadIds(MaxThreads());
+    PerThread<std::vector<Index>> threadIds;
     ParallelFor(
       nb, 256,
       [&](Index begin, Index end) {
-        std::vector<Index>& ids = threadIds[ThreadIndex()];
+        std::vector<Index>& ids = threadIds.Local();
         for (Index b = begin; b < end; ++b)
         {
           if (!active[b])
@@ -444,13 +444,13 @@ std::vector<int> SPHFluid::NeighborCounts(const SPHState& state)
   }
   this->Grid.SetCellsByPosition(false); // the particles' own order: the CUDA integrator rebuilds it (SPHDevice.h)
   this->Grid.Build(state.Position.data(), n, this->H);
-  std::vector<std::vector<Index>> threadIds(MaxThreads());
-  std::vector<std::vector<double>> threadDistances(MaxThreads());
+  PerThread<std::vector<Index>> threadIds;
+  PerThread<std::vector<double>> threadDistances;
   ParallelFor(
     n, 256,
     [&](Index begin, Index end) {
-      std::vector<Index>& ids = threadIds[ThreadIndex()];
-      std::vector<double>& d2 = threadDistances[ThreadIndex()];
+      std::vector<Index>& ids = threadIds.Local();
+      std::vector<double>& d2 = threadDistances.Local();
       for (Index i = begin; i < end; ++i)
       {
         // Strictly inside the support, as the sums count them.

@@ -114,13 +114,13 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
   const Index chunk = 65536;
   bool aborted = false;
   Index projected = 0;
-  std::vector<FieldScratch> scratch(fits ? static_cast<size_t>(MaxThreads()) : 0);
+  PerThread<FieldScratch> scratch;
   for (Index begin = 0; fits && begin < nv && !aborted; begin += chunk)
   {
     const Index end = std::min(nv, begin + chunk);
     projected += ParallelReduce(end - begin, 256, Index(0),
       [&](Index b0, Index b1) {
-        FieldScratch& fs = scratch[static_cast<size_t>(ThreadIndex())];
+        FieldScratch& fs = scratch.Local();
         Index count = 0;
         for (Index s = begin + b0; s < begin + b1; ++s)
         {

@@ -99,10 +99,10 @@ std::vector<unsigned char> TrimmedTriangles(const TriangleMesh& mesh, const std:
     std::vector<Index> Positions;
     std::vector<double> Dist2;
   };
-  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
+  PerThread<Buffers> buffers;
   const double* sorted = grid.SortedPoints();
   ParallelFor(nv, 256, [&](Index begin, Index end) {
-    Buffers& b = buffers[static_cast<size_t>(ThreadIndex())];
+    Buffers& b = buffers.Local();
     for (Index v = begin; v < end; ++v)
     {
       if (distance[v] <= near[v])

@@ -49,9 +49,9 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
     std::vector<Index> Ids;
     std::vector<double> Dist2;
   };
-  std::vector<Query> queries(static_cast<size_t>(MaxThreads()));
+  PerThread<Query> queries;
   ParallelFor(samples, 16, [&](Index begin, Index end) {
-    Query& q = queries[static_cast<size_t>(ThreadIndex())];
+    Query& q = queries.Local();
     for (Index j = begin; j < end; ++j)
     {
       const int found = grid.FindKNearest(sorted + 3 * (j * nv / samples), k + 1, q.Ids, q.Dist2);
@@ -76,7 +76,7 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
   std::vector<double> density(static_cast<size_t>(samples), 0.0);
   const double invH = 1.0 / this->H;
   ParallelFor(samples, 16, [&](Index begin, Index end) {
-    Query& q = queries[static_cast<size_t>(ThreadIndex())];
+    Query& q = queries.Local();
     for (Index j = begin; j < end; ++j)
     {
       grid.FindWithinRadiusPositions(sorted + 3 * (j * nv / samples), this->H, q.Ids, q.Dist2);
@@ -123,7 +123,7 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
   };
   const Extent largest = ParallelReduce(nv, 256, Extent(),
     [&](Index begin, Index end) {
-      Query& buffers = queries[static_cast<size_t>(ThreadIndex())];
+      Query& buffers = queries.Local();
       std::vector<Index>& pos = buffers.Ids;
       std::vector<double>& d2 = buffers.Dist2;
       Extent mine;

@@ -176,9 +176,9 @@ void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, con
     std::vector<Index> Positions;
     std::vector<double> Dist2, UVH, Weights;
   };
-  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
+  PerThread<Buffers> buffers;
   ParallelFor(candidates, 64, [&](Index begin, Index end) {
-    Buffers& mine = buffers[static_cast<size_t>(ThreadIndex())];
+    Buffers& mine = buffers.Local();
     std::vector<Index>& pos = mine.Positions;
     std::vector<double>& d2 = mine.Dist2;
     std::vector<double>& uvh = mine.UVH;

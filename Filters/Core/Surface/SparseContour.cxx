@@ -415,14 +415,14 @@ bool EvaluatePending(Lattice& lattice, const ImplicitField& field, ContourReport
     Index Evaluated = 0;
     Index Undefined = 0;
   };
-  std::vector<FieldScratch> scratch(static_cast<size_t>(MaxThreads()));
+  PerThread<FieldScratch> scratch;
   for (Index begin = 0; begin < count; begin += Chunk)
   {
     const Index end = std::min(count, begin + Chunk);
     // Ranges of one lattice block (up to 512 corners to evaluate).
     const Counts counts = ParallelReduce(end - begin, 1, Counts(),
       [&](Index b0, Index b1) {
-        FieldScratch& s = scratch[static_cast<size_t>(ThreadIndex())];
+        FieldScratch& s = scratch.Local();
         Counts mine;
         for (Index p = begin + b0; p < begin + b1; ++p)
         {

@@ -279,9 +279,9 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
     std::vector<Index> Ids, Positions;
     std::vector<double> Dist2;
   };
-  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
+  PerThread<Buffers> buffers;
   ParallelFor(samples, 16, [&](Index begin, Index end) {
-    Buffers& mine = buffers[static_cast<size_t>(ThreadIndex())];
+    Buffers& mine = buffers.Local();
     std::vector<Index>& ids = mine.Ids;
     std::vector<double>& d2 = mine.Dist2;
     std::vector<Index>& pos = mine.Positions;
@@ -312,8 +312,8 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
   for (int round = 0; round < 3 && radius > rk; ++round)
   {
     ParallelFor(samples, 16, [&](Index begin, Index end) {
-      std::vector<Index>& pos = buffers[static_cast<size_t>(ThreadIndex())].Positions;
-      std::vector<double>& d2 = buffers[static_cast<size_t>(ThreadIndex())].Dist2;
+      std::vector<Index>& pos = buffers.Local().Positions;
+      std::vector<double>& d2 = buffers.Local().Dist2;
       for (Index j = begin; j < end; ++j)
       {
         const double* x = sorted + 3 * (j * nv / samples);
@@ -379,13 +379,13 @@ bool EstimateNormals(
     std::vector<Index> Ids, Positions;
     std::vector<double> Dist2, Radius2, Keys;
   };
-  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
+  PerThread<Buffers> buffers;
   for (Index begin = 0; begin < nv && !aborted; begin += chunk)
   {
     const Index end = std::min(nv, begin + chunk);
     const Index bad = ParallelReduce(end - begin, 256, Index(0),
       [&](Index b0, Index b1) {
-        Buffers& mine = buffers[static_cast<size_t>(ThreadIndex())];
+        Buffers& mine = buffers.Local();
         std::vector<Index>& ids = mine.Ids;
         std::vector<Index>& pos = mine.Positions;
         std::vector<double>& d2 = mine.Dist2;

@@ -139,9 +139,9 @@ std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitFie
   const Index count = static_cast<Index>(blocks.size());
   std::vector<std::uint64_t> seeds(static_cast<size_t>(count), 0);
   std::vector<unsigned char> ok(static_cast<size_t>(count), 0);
-  std::vector<FieldScratch> scratches(static_cast<size_t>(MaxThreads()));
+  PerThread<FieldScratch> scratches;
   ParallelFor(count, 64, [&](Index begin, Index end) {
-    FieldScratch& scratch = scratches[static_cast<size_t>(ThreadIndex())];
+    FieldScratch& scratch = scratches.Local();
     for (Index b = begin; b < end; ++b)
     {
       double x[3], n[3];
@@ -187,10 +187,10 @@ Index ProjectVertices(const ImplicitField& field, double maxStep, bool project, 
   const Index nv = mesh.NumberOfPoints();
   mesh.Normals.assign(static_cast<size_t>(3 * nv), 0.0);
   std::vector<unsigned char> done(static_cast<size_t>(nv), 0);
-  std::vector<FieldScratch> scratches(static_cast<size_t>(MaxThreads()));
+  PerThread<FieldScratch> scratches;
   const Index projected = ParallelReduce(nv, 512, Index(0),
     [&](Index begin, Index end) {
-      FieldScratch& scratch = scratches[static_cast<size_t>(ThreadIndex())];
+      FieldScratch& scratch = scratches.Local();
       Index count = 0;
       for (Index v = begin; v < end; ++v)
       {
