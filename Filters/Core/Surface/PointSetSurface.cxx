@@ -36,6 +36,78 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     largest = std::max(largest, r);
   }
   this->QueryRadius = largest;
+  // The two tiers (class comment): split at the 90th percentile of the supports.
+  std::vector<double> supports;
+  supports.reserve(static_cast<size_t>(nv));
+  for (Index s = 0; s < nv; ++s)
+  {
+    if (std::isfinite(this->InverseRadii[s]))
+    {
+      supports.push_back(1.0 / this->InverseRadii[s]);
+    }
+  }
+  this->NearRadius = largest;
+  this->InWide.assign(static_cast<size_t>(nv), 0);
+  this->WidePositions.clear();
+  this->Wide = NeighborGrid();
+  if (supports.size() >= 64)
+  {
+    const size_t q = supports.size() * 9 / 10;
+    std::nth_element(supports.begin(), supports.begin() + static_cast<std::ptrdiff_t>(q), supports.end());
+    const double split = supports[q];
+    if (split < 0.9 * largest)
+    {
+      this->NearRadius = split;
+      std::vector<double> wide;
+      std::vector<Index> positions;
+      const double* xyz = grid.SortedPoints();
+      for (Index s = 0; s < nv; ++s)
+      {
+        if (std::isfinite(this->InverseRadii[s]) && 1.0 / this->InverseRadii[s] > split)
+        {
+          this->InWide[s] = 1;
+          wide.insert(wide.end(), xyz + 3 * s, xyz + 3 * s + 3);
+          positions.push_back(s);
+        }
+      }
+      this->Wide.SetCellsByPosition(false);
+      this->Wide.Build(wide.data(), static_cast<Index>(positions.size()));
+      const std::vector<Index>& wideOrder = this->Wide.SortedOrder();
+      this->WidePositions.resize(wideOrder.size());
+      for (size_t w = 0; w < wideOrder.size(); ++w)
+      {
+        this->WidePositions[w] = positions[static_cast<size_t>(wideOrder[w])];
+      }
+    }
+  }
+}
+
+void PointSetSurface::Gather(const double x[3], FieldScratch& s) const
+{
+  this->Grid->FindWithinRadiusPositions(x, this->NearRadius, s.Positions, s.Dist2);
+  if (this->WidePositions.empty())
+  {
+    return;
+  }
+  // The wide-support samples come from their own grid: drop them here (they are found again there).
+  size_t kept = 0;
+  for (size_t j = 0; j < s.Positions.size(); ++j)
+  {
+    if (!this->InWide[static_cast<size_t>(s.Positions[j])])
+    {
+      s.Positions[kept] = s.Positions[j];
+      s.Dist2[kept] = s.Dist2[j];
+      ++kept;
+    }
+  }
+  s.Positions.resize(kept);
+  s.Dist2.resize(kept);
+  this->Wide.FindWithinRadiusPositions(x, this->QueryRadius, s.MorePositions, s.MoreDist2);
+  for (size_t j = 0; j < s.MorePositions.size(); ++j)
+  {
+    s.Positions.push_back(this->WidePositions[static_cast<size_t>(s.MorePositions[j])]);
+    s.Dist2.push_back(s.MoreDist2[j]);
+  }
 }
 
 bool PointSetSurface::Fit(const double x[3], SphereFit& fit, FieldScratch& s) const
@@ -44,7 +116,7 @@ bool PointSetSurface::Fit(const double x[3], SphereFit& fit, FieldScratch& s) co
   {
     return false;
   }
-  this->Grid->FindWithinRadiusPositions(x, this->QueryRadius, s.Positions, s.Dist2);
+  this->Gather(x, s);
   const size_t found = s.Positions.size();
   if (found < static_cast<size_t>(this->MinimumNeighbors))
   {
