@@ -36,7 +36,7 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     largest = std::max(largest, r);
   }
   this->QueryRadius = largest;
-  // The two tiers (class comment): split at the 90th percentile of the supports.
+  // The tiers (class comment): split at the 50th, 90th and 99th percentiles of the supports.
   std::vector<double> supports;
   supports.reserve(static_cast<size_t>(nv));
   for (Index s = 0; s < nv; ++s)
@@ -46,67 +46,83 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
       supports.push_back(1.0 / this->InverseRadii[s]);
     }
   }
+  this->Tiers.clear();
   this->NearRadius = largest;
-  this->InWide.assign(static_cast<size_t>(nv), 0);
-  this->WidePositions.clear();
-  this->Wide = NeighborGrid();
-  if (supports.size() >= 64)
+  if (supports.size() < 64)
   {
-    const size_t q = supports.size() * 9 / 10;
-    std::nth_element(supports.begin(), supports.begin() + static_cast<std::ptrdiff_t>(q), supports.end());
-    const double split = supports[q];
-    if (split < 0.9 * largest)
+    return; // one query with the largest support
+  }
+  std::sort(supports.begin(), supports.end());
+  std::vector<double> bounds;
+  for (const double share : { 0.5, 0.9, 0.99 })
+  {
+    const double split = supports[static_cast<size_t>(share * static_cast<double>(supports.size() - 1))];
+    // A tier must narrow the query noticeably.
+    if (split < 0.9 * largest && (bounds.empty() || split > 1.1 * bounds.back()))
     {
-      this->NearRadius = split;
-      std::vector<double> wide;
-      std::vector<Index> positions;
-      const double* xyz = grid.SortedPoints();
-      for (Index s = 0; s < nv; ++s)
-      {
-        if (std::isfinite(this->InverseRadii[s]) && 1.0 / this->InverseRadii[s] > split)
-        {
-          this->InWide[s] = 1;
-          wide.insert(wide.end(), xyz + 3 * s, xyz + 3 * s + 3);
-          positions.push_back(s);
-        }
-      }
-      this->Wide.SetCellsByPosition(false);
-      this->Wide.Build(wide.data(), static_cast<Index>(positions.size()));
-      const std::vector<Index>& wideOrder = this->Wide.SortedOrder();
-      this->WidePositions.resize(wideOrder.size());
-      for (size_t w = 0; w < wideOrder.size(); ++w)
-      {
-        this->WidePositions[w] = positions[static_cast<size_t>(wideOrder[w])];
-      }
+      bounds.push_back(split);
+    }
+  }
+  if (bounds.empty())
+  {
+    return;
+  }
+  bounds.push_back(largest);
+  this->NearRadius = bounds.front();
+  this->Tiers.resize(bounds.size());
+  std::vector<std::vector<double>> coordinates(bounds.size());
+  std::vector<std::vector<Index>> positions(bounds.size());
+  const double* xyz = grid.SortedPoints();
+  for (Index s = 0; s < nv; ++s)
+  {
+    if (!std::isfinite(this->InverseRadii[s]))
+    {
+      continue;
+    }
+    const double r = 1.0 / this->InverseRadii[s];
+    const size_t t = static_cast<size_t>(std::lower_bound(bounds.begin(), bounds.end(), r) - bounds.begin());
+    const size_t tier = std::min(t, bounds.size() - 1);
+    coordinates[tier].insert(coordinates[tier].end(), xyz + 3 * s, xyz + 3 * s + 3);
+    positions[tier].push_back(s);
+  }
+  for (size_t t = 0; t < bounds.size(); ++t)
+  {
+    Tier& tier = this->Tiers[t];
+    tier.Radius = bounds[t];
+    tier.Grid.SetCellsByPosition(false);
+    // Cells as wide as the query (the automatic size fills the bounding box: a scan's surface crosses few, crowded
+    // cells, and the distance filter then saw about ten candidates per neighbour).
+    tier.Grid.Build(coordinates[t].data(), static_cast<Index>(positions[t].size()));
+    const std::vector<Index>& order = tier.Grid.SortedOrder();
+    tier.Positions.resize(order.size());
+    for (size_t w = 0; w < order.size(); ++w)
+    {
+      tier.Positions[w] = positions[t][static_cast<size_t>(order[w])];
     }
   }
 }
 
 void PointSetSurface::Gather(const double x[3], FieldScratch& s) const
 {
-  this->Grid->FindWithinRadiusPositions(x, this->NearRadius, s.Positions, s.Dist2);
-  if (this->WidePositions.empty())
+  if (this->Tiers.empty())
   {
+    this->Grid->FindWithinRadiusPositions(x, this->QueryRadius, s.Positions, s.Dist2);
     return;
   }
-  // The wide-support samples come from their own grid: drop them here (they are found again there).
-  size_t kept = 0;
-  for (size_t j = 0; j < s.Positions.size(); ++j)
+  s.Positions.clear();
+  s.Dist2.clear();
+  for (const Tier& tier : this->Tiers)
   {
-    if (!this->InWide[static_cast<size_t>(s.Positions[j])])
+    if (tier.Positions.empty())
     {
-      s.Positions[kept] = s.Positions[j];
-      s.Dist2[kept] = s.Dist2[j];
-      ++kept;
+      continue;
     }
-  }
-  s.Positions.resize(kept);
-  s.Dist2.resize(kept);
-  this->Wide.FindWithinRadiusPositions(x, this->QueryRadius, s.MorePositions, s.MoreDist2);
-  for (size_t j = 0; j < s.MorePositions.size(); ++j)
-  {
-    s.Positions.push_back(this->WidePositions[static_cast<size_t>(s.MorePositions[j])]);
-    s.Dist2.push_back(s.MoreDist2[j]);
+    tier.Grid.FindWithinRadiusPositions(x, tier.Radius, s.MorePositions, s.MoreDist2);
+    for (size_t j = 0; j < s.MorePositions.size(); ++j)
+    {
+      s.Positions.push_back(tier.Positions[static_cast<size_t>(s.MorePositions[j])]);
+      s.Dist2.push_back(s.MoreDist2[j]);
+    }
   }
 }
 
