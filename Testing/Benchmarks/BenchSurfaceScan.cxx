@@ -4,7 +4,7 @@
 //        [--support-scale S] [--neighbors K] [--noise-scale S] [--cell SIZE]
 // CLOUD.xyz: "x y z" per line (scans_data.py's NAME.xyz). MESH.bin: int64 vertex count, int64 triangle count,
 // then the vertices (3 doubles each), the triangles (3 int64 each) and DistanceToData (1 double per vertex); read
-// it with numpy (scans_score.read_bin). Prints one line per run: the report's stage seconds and counts.
+// it with numpy (scans_score.read_bin, or read_mesh). Prints one line per run: the report's stage seconds and counts.
 // Threads: all the CPUs, or MESHFREE_NUM_THREADS.
 #include "Common/Parallel.h"
 #include "Surface/MeshTopology.h"
