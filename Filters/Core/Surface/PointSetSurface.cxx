@@ -68,6 +68,22 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     return;
   }
   bounds.push_back(largest);
+  // Worth it only when the tiers gather clearly fewer points than one query (a surface's points within r grow as
+  // r^2): sum over tiers of (share of samples) x radius^2 below 0.7 largest^2. A uniform cloud's supports are
+  // nearly equal, and it keeps the single query.
+  double cost = 0.0;
+  size_t below = 0;
+  for (const double bound : bounds)
+  {
+    const size_t upto =
+      static_cast<size_t>(std::upper_bound(supports.begin(), supports.end(), bound) - supports.begin());
+    cost += static_cast<double>(upto - below) / static_cast<double>(supports.size()) * bound * bound;
+    below = upto;
+  }
+  if (!(cost < 0.7 * largest * largest))
+  {
+    return;
+  }
   this->NearRadius = bounds.front();
   this->Tiers.resize(bounds.size());
   std::vector<std::vector<double>> coordinates(bounds.size());

@@ -31,7 +31,8 @@
  * Neighbour queries in tiers: the supports of a scan spread widely (bunny: median 1.9e-3, 90th percentile
  * 2.4e-3, largest 5.8e-3), and one query with the largest support gathered about 9 times the points that carry
  * weight. The samples are split at the 50th, 90th and 99th percentiles of their supports, each tier in a grid
- * of its own queried with its largest support. The same samples, the same weights.
+ * of its own queried with its largest support, when that gathers clearly fewer points than one query (a cloud
+ * of uniform density keeps the single query). The same samples, the same weights.
  */
 #ifndef meshfree_PointSetSurface_h
 #define meshfree_PointSetSurface_h
