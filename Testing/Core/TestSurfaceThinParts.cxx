@@ -180,10 +180,12 @@ TEST(SurfaceThinParts, ThinSlabStaysOneClosedSheet)
 
 TEST(SurfaceThinParts, ThinRodStaysOneClosedTube)
 {
-  // A capsule of radius 0.02 around a segment of length 1: 4,000 samples (spacing about 0.006), so the rod's
-  // diameter is about the fits' support (reported below); noise 0.0005.
+  // A capsule of radius 0.02 around a segment of length 1: 2,500 samples (spacing about 0.007), so the fits'
+  // support (0.036, reported below) is about the rod's diameter; noise 0.0005. Measured: closed, one piece, volume
+  // -1.4 % (MLS) / -3.7 % (WLS), worst vertex 0.0024 / 0.0009 (at the caps). Limit (not tested): with 1,500
+  // samples the support grows to twice the diameter and the tube swells (volume +7 % / +23 %).
   const double radius = 0.02, half = 0.5, sigma = 0.0005;
-  const std::vector<double> points = SampleCapsule(radius, half, 4000, sigma, 4);
+  const std::vector<double> points = SampleCapsule(radius, half, 2500, sigma, 4);
   for (SurfaceMethod method : { SurfaceMethod::MLS, SurfaceMethod::WLS })
   {
     const Result r = Reconstruct(points, method);
@@ -194,12 +196,12 @@ TEST(SurfaceThinParts, ThinRodStaysOneClosedTube)
       SurfaceMethodName(method), r.Report.SupportRadius, 2.0 * radius, static_cast<long>(r.Topology.Triangles),
       static_cast<long>(r.Topology.BoundaryEdges), static_cast<long>(r.Topology.Components),
       static_cast<long>(r.Topology.EulerCharacteristic), r.Volume, volume, worst);
-    EXPECT_GT(r.Report.SupportRadius, radius) << "the rod must be thinner than twice the support";
+    EXPECT_GT(r.Report.SupportRadius, 0.8 * 2.0 * radius) << "the rod must be about as thin as the support";
     EXPECT_TRUE(r.Topology.Closed()) << SurfaceMethodName(method);
     EXPECT_EQ(r.Topology.Components, 1) << SurfaceMethodName(method);
     EXPECT_EQ(r.Topology.EulerCharacteristic, 2) << SurfaceMethodName(method);
-    EXPECT_NEAR(r.Volume, volume, 0.1 * volume) << SurfaceMethodName(method); // measured -3.0 %, -3.6 %
-    EXPECT_LT(worst, 0.1 * radius) << SurfaceMethodName(method); // measured 0.0011 (2.2 sigma)
+    EXPECT_NEAR(r.Volume, volume, 0.1 * volume) << SurfaceMethodName(method);
+    EXPECT_LT(worst, 0.15 * radius) << SurfaceMethodName(method);
   }
 }
 
