@@ -272,11 +272,26 @@ def polydata_arrays(pd):
     return pts, np.array(tri, dtype=np.int64).reshape(-1, 3)
 
 
+def read_bin(path):
+    """points, triangles, DistanceToData of BenchSurfaceScan's --out file (int64 counts, then float64 points,
+    int64 triangles, float64 distances)."""
+    raw = open(path, "rb").read()
+    nv, nt = (int(c) for c in np.frombuffer(raw[:16], dtype=np.int64))
+    o = 16
+    pts = np.frombuffer(raw[o:o + 24 * nv], dtype=np.float64).reshape(nv, 3)
+    o += 24 * nv
+    tri = np.frombuffer(raw[o:o + 24 * nt], dtype=np.int64).reshape(nt, 3)
+    o += 24 * nt
+    return pts, tri, np.frombuffer(raw[o:o + 8 * nv], dtype=np.float64)
+
+
 def read_mesh(path):
-    """points, triangles of a .off (numpy), .vtp, .vtk (legacy) or .ply (VTK readers) file."""
+    """points, triangles of a .off (numpy), .bin (BenchSurfaceScan), .vtp, .vtk (legacy) or .ply (VTK readers)."""
     low = path.lower()
     if low.endswith(".off"):
         return read_off(path)
+    if low.endswith(".bin"):
+        return read_bin(path)[:2]
     if low.endswith(".vtp"):
         from vtkmodules.vtkIOXML import vtkXMLPolyDataReader as Reader
     elif low.endswith(".vtk"):

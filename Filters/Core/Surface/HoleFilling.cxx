@@ -69,8 +69,8 @@ double FilledField::Blend(const double x[3], double gradient[3], FieldScratch& s
   {
     return 1.0;
   }
-  // The nearest sample: among the neighbours the MLS fit has just gathered (all samples within the largest
-  // support, at least the median one), else by a k = 1 query.
+  // The nearest sample: among the neighbours the MLS fit has just gathered (all samples within its narrowest
+  // tier's radius, the median support, PointSetSurface::NarrowRadius()), else by a k = 1 query.
   const double* p = nullptr;
   double d2 = std::numeric_limits<double>::infinity();
   if (fitQueried)

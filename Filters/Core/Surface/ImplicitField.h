@@ -27,6 +27,8 @@ struct FieldScratch
   std::vector<Index> Positions; // neighbours, as sorted positions of the field's grid
   std::vector<double> Dist2;
   std::vector<double> Work;
+  std::vector<Index> MorePositions; // a second query's neighbours (PointSetSurface's wide-support samples)
+  std::vector<double> MoreDist2;
 };
 
 class ImplicitField

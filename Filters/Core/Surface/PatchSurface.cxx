@@ -267,8 +267,27 @@ bool PatchSurface::Evaluate(const double x[3], double& value, double gradient[3]
     return false;
   }
   this->Centres.FindWithinRadius(x, this->QueryRadius, s.Positions, &s.Dist2);
-  double sw = 0.0, swq = 0.0;
-  double gw[3] = { 0, 0, 0 }, gwq[3] = { 0, 0, 0 }, gq[3] = { 0, 0, 0 };
+  // Two sides (the class comment's thin parts): the patches facing like the heaviest one, and those facing
+  // away from it (normals more than 120 degrees apart); the heavier side is blended.
+  const double* facing = nullptr;
+  double heaviest = 0.0;
+  for (size_t j = 0; j < s.Positions.size(); ++j)
+  {
+    const double w = Wendland(std::sqrt(s.Dist2[j]) / this->Radius[s.Positions[j]]);
+    if (w > heaviest)
+    {
+      heaviest = w;
+      facing = &this->Frames[9 * s.Positions[j] + 6];
+    }
+  }
+  if (!facing)
+  {
+    return false;
+  }
+  struct Sums
+  {
+    double W = 0.0, WQ = 0.0, GW[3] = { 0, 0, 0 }, GWQ[3] = { 0, 0, 0 }, GQ[3] = { 0, 0, 0 };
+  } sides[2];
   for (size_t j = 0; j < s.Positions.size(); ++j)
   {
     const Index p = s.Positions[j];
@@ -282,6 +301,12 @@ bool PatchSurface::Evaluate(const double x[3], double& value, double gradient[3]
     }
     const double* c = &this->Positions[3 * p];
     const double* f = &this->Frames[9 * p];
+    Sums& side = sides[f[6] * facing[0] + f[7] * facing[1] + f[8] * facing[2] < -0.5 ? 1 : 0];
+    double& sw = side.W;
+    double& swq = side.WQ;
+    double* gw = side.GW;
+    double* gwq = side.GWQ;
+    double* gq = side.GQ;
     const double* a = &this->Heights[6 * p];
     const double d[3] = { x[0] - c[0], x[1] - c[1], x[2] - c[2] };
     const double u = (f[0] * d[0] + f[1] * d[1] + f[2] * d[2]) / rho;
@@ -306,11 +331,16 @@ bool PatchSurface::Evaluate(const double x[3], double& value, double gradient[3]
       }
     }
   }
+  const Sums& used = sides[sides[1].W > sides[0].W ? 1 : 0];
+  const double sw = used.W;
   if (!(sw > 0.0))
   {
     return false;
   }
-  value = swq / sw;
+  const double* gw = used.GW;
+  const double* gwq = used.GWQ;
+  const double* gq = used.GQ;
+  value = used.WQ / sw;
   if (gradient)
   {
     // grad (sum w Q / sum w) = (sum w grad Q + sum grad w (Q - f)) / sum w

@@ -17,6 +17,13 @@
  * w_c = Wendland(|x - c| / rho). The fit is done once per patch, not per evaluation point: evaluation visits
  * the few patches within rho instead of every neighbour point, which makes WLS cheaper than MLS; a quadric
  * per patch also follows curvature without the plane's O(kappa rho^2) bias. Undefined where no patch reaches.
+ *
+ * Thin parts: where a sheet is thinner than rho, the patches of its two sides reach the same points, and
+ * blending a side's distance (0 on it) with the other side's (minus the thickness there) moved both faces
+ * outward (a slab 0.06 thick, rho 0.09: faces 6.8 sigma off, volume +6 %). The patches whose normal is more
+ * than 120 degrees from the heaviest patch's are the other side: each side is blended on its own and the heavier
+ * one taken (inside the sheet both are negative, so the switch adds no zero; the MLS fit splits its neighbours
+ * the same way, PointSetSurface.h).
  */
 #ifndef meshfree_PatchSurface_h
 #define meshfree_PatchSurface_h

@@ -36,6 +36,110 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     largest = std::max(largest, r);
   }
   this->QueryRadius = largest;
+  // The tiers (class comment): split at the 50th, 90th and 99th percentiles of the supports.
+  std::vector<double> supports;
+  supports.reserve(static_cast<size_t>(nv));
+  for (Index s = 0; s < nv; ++s)
+  {
+    if (std::isfinite(this->InverseRadii[s]))
+    {
+      supports.push_back(1.0 / this->InverseRadii[s]);
+    }
+  }
+  this->Tiers.clear();
+  this->NearRadius = largest;
+  if (supports.size() < 64)
+  {
+    return; // one query with the largest support
+  }
+  std::sort(supports.begin(), supports.end());
+  std::vector<double> bounds;
+  for (const double share : { 0.5, 0.9, 0.99 })
+  {
+    const double split = supports[static_cast<size_t>(share * static_cast<double>(supports.size() - 1))];
+    // A tier must narrow the query noticeably.
+    if (split < 0.9 * largest && (bounds.empty() || split > 1.1 * bounds.back()))
+    {
+      bounds.push_back(split);
+    }
+  }
+  if (bounds.empty())
+  {
+    return;
+  }
+  bounds.push_back(largest);
+  // Worth it only when the tiers gather clearly fewer points than one query (a surface's points within r grow as
+  // r^2): sum over tiers of (share of samples) x radius^2 below 0.7 largest^2. A uniform cloud's supports are
+  // nearly equal, and it keeps the single query.
+  double cost = 0.0;
+  size_t below = 0;
+  for (const double bound : bounds)
+  {
+    const size_t upto =
+      static_cast<size_t>(std::upper_bound(supports.begin(), supports.end(), bound) - supports.begin());
+    cost += static_cast<double>(upto - below) / static_cast<double>(supports.size()) * bound * bound;
+    below = upto;
+  }
+  if (!(cost < 0.7 * largest * largest))
+  {
+    return;
+  }
+  this->NearRadius = bounds.front();
+  this->Tiers.resize(bounds.size());
+  std::vector<std::vector<double>> coordinates(bounds.size());
+  std::vector<std::vector<Index>> positions(bounds.size());
+  const double* xyz = grid.SortedPoints();
+  for (Index s = 0; s < nv; ++s)
+  {
+    if (!std::isfinite(this->InverseRadii[s]))
+    {
+      continue;
+    }
+    const double r = 1.0 / this->InverseRadii[s];
+    const size_t t = static_cast<size_t>(std::lower_bound(bounds.begin(), bounds.end(), r) - bounds.begin());
+    const size_t tier = std::min(t, bounds.size() - 1);
+    coordinates[tier].insert(coordinates[tier].end(), xyz + 3 * s, xyz + 3 * s + 3);
+    positions[tier].push_back(s);
+  }
+  for (size_t t = 0; t < bounds.size(); ++t)
+  {
+    Tier& tier = this->Tiers[t];
+    tier.Radius = bounds[t];
+    tier.Grid.SetCellsByPosition(false);
+    // Cells as wide as the query (the automatic size fills the bounding box: a scan's surface crosses few, crowded
+    // cells, and the distance filter then saw about ten candidates per neighbour).
+    tier.Grid.Build(coordinates[t].data(), static_cast<Index>(positions[t].size()));
+    const std::vector<Index>& order = tier.Grid.SortedOrder();
+    tier.Positions.resize(order.size());
+    for (size_t w = 0; w < order.size(); ++w)
+    {
+      tier.Positions[w] = positions[t][static_cast<size_t>(order[w])];
+    }
+  }
+}
+
+void PointSetSurface::Gather(const double x[3], FieldScratch& s) const
+{
+  if (this->Tiers.empty())
+  {
+    this->Grid->FindWithinRadiusPositions(x, this->QueryRadius, s.Positions, s.Dist2);
+    return;
+  }
+  s.Positions.clear();
+  s.Dist2.clear();
+  for (const Tier& tier : this->Tiers)
+  {
+    if (tier.Positions.empty())
+    {
+      continue;
+    }
+    tier.Grid.FindWithinRadiusPositions(x, tier.Radius, s.MorePositions, s.MoreDist2);
+    for (size_t j = 0; j < s.MorePositions.size(); ++j)
+    {
+      s.Positions.push_back(tier.Positions[static_cast<size_t>(s.MorePositions[j])]);
+      s.Dist2.push_back(s.MoreDist2[j]);
+    }
+  }
 }
 
 bool PointSetSurface::Fit(const double x[3], SphereFit& fit, FieldScratch& s) const
@@ -44,7 +148,7 @@ bool PointSetSurface::Fit(const double x[3], SphereFit& fit, FieldScratch& s) co
   {
     return false;
   }
-  this->Grid->FindWithinRadiusPositions(x, this->QueryRadius, s.Positions, s.Dist2);
+  this->Gather(x, s);
   const size_t found = s.Positions.size();
   if (found < static_cast<size_t>(this->MinimumNeighbors))
   {
