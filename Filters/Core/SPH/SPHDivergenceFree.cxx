@@ -9,7 +9,8 @@
 // Per step, from (x, v):
 //  1. neighbour lists at x; density rho_i (the kernel sum, wall dummies included) and the factor
 //     alpha_i = rho_i / ((sum_f G + 2 sum_b G) . (sum_f G + sum_b G) + sum_f |G_ij|^2), the exact response of the
-//     particle's own density rate to its own P (0 for a particle with too few neighbours to be pushed);
+//     particle's own density rate to its own P, bounded below by a tenth of an interior particle's value (a
+//     particle wedged in a corner could otherwise be kicked at tens of m/s; 0 for a particle without neighbours);
 //  2. the step from the velocity alone: dt = lambda min(0.4 h / v_max, sqrt(h / |g|), 0.125 h^2 / nu), lambda =
 //     CFLNumber (0.25 by default: 0.2 dx / v_max with h = 2 dx, SPlisHSPlasH's default; capped at 0.4), at most
 //     TimeStep;
@@ -18,7 +19,9 @@
 //  4. the non-pressure accelerations (gravity, viscosity, artificial viscosity, surface tension: the WCSPH terms
 //     with zero pressure; plus the hydrostatic part of the wall pressure, below) with an explicit step: v* = v + dt a;
 //  5. density solve on v*: P_i <- max(P_i + w alpha_i (rho*_i - rho0) / dt, 0), rho*_i = rho_i + dt Drho/Dt_i(v*),
-//     until the average compression max(rho*_i - rho0, 0) / rho0 is at most DensityTolerance (percent);
+//     until the average compression max(rho*_i - rho0, 0) / rho0 is at most DensityTolerance (percent); a
+//     compression already present (rho_i > rho0) counts for at most rho0 sqrt(|g| h) dt / h per step, so that it
+//     is removed at that speed rather than by a kick of (rho_i / rho0 - 1) h / dt;
 //  6. x += dt v*, then the wall and obstacle projection of WCSPH (a guarantee; the pressure keeps particles off).
 // The iterations are Jacobi's, relaxed (w = 0.5: unrelaxed, the checkerboard modes of the pressure grow, as they
 // do in IISPH, which uses the same relaxation) and projected on P >= 0 (pressure only pushes, as WCSPH's clamped
@@ -103,7 +106,7 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
   this->WallCoefficient.resize(bs[n]);
   const SPHConstants& c = this->Physics;
   const SPHDensityConstants dc = SPHDensityConstantsOf(c);
-  const double cutoff = 1e-6 * this->LatticeFactorSum;
+  const double cutoff = 1e-9 * this->LatticeFactorSum;
   double* rho = state.Density.data();
   double* pair = this->PairCoefficient.data();
   double* wall = this->WallCoefficient.data();
@@ -149,7 +152,11 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
         // and its fluid neighbours by -G_ij: its density rate changes by -dt kappa_i / rho_i times this.
         const double total = (fluidSum[0] + 2.0 * wallSum[0]) * sum[0] + (fluidSum[1] + 2.0 * wallSum[1]) * sum[1] +
           (fluidSum[2] + 2.0 * wallSum[2]) * sum[2] + squares;
-        this->Alpha[i] = total > cutoff ? rho[i] / total : 0.0;
+        // Bounded below: the mirrored wall term can nearly cancel the first product for a particle wedged in a
+        // corner or against an obstacle edge, and a tiny denominator would kick it at tens of m/s (measured in
+        // SPHERIC Test 2); a tenth of an interior particle's value only slows the correction of sparse particles.
+        const double bounded = std::max({ total, squares, 0.1 * this->LatticeFactorSum });
+        this->Alpha[i] = total > cutoff || squares > cutoff ? rho[i] / bounded : 0.0;
       }
     },
     ParallelThreshold);
@@ -281,6 +288,13 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
   // over-pressure (from the warm start) relax. Residual: |e_i| where P_i > 0, max(e_i, 0) where P_i = 0; the solve
   // stops when its average (scaled to a fraction of rho0) reaches the tolerance. `error` is the average
   // compression max(e_i, 0), the figure peers report.
+  // A compression that is already there (particles placed too close, e.g. a fluid lattice not aligned with the
+  // walls' one, or a splash landing) is removed over several steps: at most the compression that a correction
+  // speed of sqrt(|g| h) (at least 0.1 m/s) removes in one step. The papers' form removes it in one step, which
+  // kicks the particles at (compression / rho0) h / dt: tens of m/s at the start of SPHERIC Test 2 (measured).
+  const double* g = this->Physics.Gravity;
+  const double speed = std::max(std::sqrt(std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) * this->H), 0.1);
+  const double overlap = rho0 * speed * dt / this->H;
   int iterations = 0;
   const double invDt = 1.0 / dt;
   const double scale = density ? 1.0 / rho0 : dt / rho0;
@@ -309,7 +323,9 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
             const double* xb = bx + 3 * static_cast<Index>(bn[s]);
             rate -= wall[s] * (vi[0] * (xi[0] - xb[0]) + vi[1] * (xi[1] - xb[1]) + vi[2] * (xi[2] - xb[2]));
           }
-          const double e = density ? rho[i] + dt * rate - rho0 : rate;
+          // The density error: the compression the particle has now, at most `overlap` (see below), plus what
+          // its velocity would add over the step.
+          const double e = density ? std::min(rho[i] - rho0, overlap) + dt * rate : rate;
           const double next = std::max(total[i] + Relaxation * alpha[i] * e * (density ? invDt : 1.0), 0.0);
           kr[i] = (next - total[i]) * inverse[i];
           compression[i] = std::max(e, 0.0) * scale;
