@@ -7,6 +7,7 @@ Probes:
   water heights H1-H4 at x = 0.496, 0.992, 1.488, 2.638 m (y = 0.5: the tank's centre line);
   pressures P1-P4 on the box's front face (x = 0.8245, y = 0.471, z = 0.021, 0.061, 0.101, 0.141 m) and P5-P8 on
   its top (z = 0.161, y = 0.471, x = 0.8035, 0.7635, 0.7235, 0.6835 m).
+The column is placed on the tank's lattice (its length rounded to a whole number of spacings from the far wall).
 Estimators (this script's choices, recorded in the CSV header): a water height is the highest particle centre plus
 half a spacing among the particles within one spacing of the gauge's vertical line (0 when there is none); a
 pressure is the Shepard (kernel-weighted) average of the particle pressures within the support radius h = 2 dx
@@ -64,7 +65,10 @@ def make_scene(namespace, dx, end, interval, solver, viscosity=1e-3):
     surface = simple.Triangulate(Input=box)
     fluid = namespace["SPHFluidWithObstacles"](Obstacles=surface)
     fluid.Dimension = 3
-    fluid.FluidBounds = WATER
+    # The column on the tank's lattice: round(1.228 / dx) particles long from the far wall (1.24 m at dx = 0.04,
+    # 1.22 m at 0.02). Started at x = 1.992 instead, the last particles would sit 0.2 dx from the wall at dx = 0.04.
+    length = round((WATER[1] - WATER[0]) / dx) * dx
+    fluid.FluidBounds = [TANK[1] - length] + WATER[1:]
     fluid.DomainBounds = TANK
     fluid.ParticleSpacing = dx
     fluid.Viscosity = viscosity

@@ -90,6 +90,7 @@ ColumnResult Column(int dimension, SPHState* out = nullptr)
   {
     const double z = s.Position[3 * i + 2];
     const double exact = p.RestDensity * g * (H - z);
+    EXPECT_GE(s.Pressure[i], 0.0);
     num += (s.Pressure[i] - exact) * (s.Pressure[i] - exact);
     den += exact * exact;
     r.AverageDensityError += std::max(s.Density[i] / p.RestDensity - 1.0, 0.0);
