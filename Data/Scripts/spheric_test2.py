@@ -8,9 +8,9 @@ Probes:
   pressures P1-P4 on the box's front face (x = 0.8245, y = 0.471, z = 0.021, 0.061, 0.101, 0.141 m) and P5-P8 on
   its top (z = 0.161, y = 0.471, x = 0.8035, 0.7635, 0.7235, 0.6835 m).
 The column is placed on the tank's lattice (its length rounded to a whole number of spacings from the far wall).
-Estimators (this script's choices, recorded in the CSV header): a water height is the highest particle centre plus
-half a spacing among the particles within one spacing of the gauge's vertical line (0 when there is none); a
-pressure is the Shepard (kernel-weighted) average of the particle pressures within the support radius h = 2 dx
+Estimators (this script's choices, recorded in the CSV header): a water height is the water depth at the gauge, the
+particles' volume dx^3 spread by a tent of half-width 2 dx in x and in y (a splash adds its volume, not its
+height); a pressure is the Shepard (kernel-weighted) average of the particle pressures within the support radius h = 2 dx
 of the probe point moved half a spacing into the fluid (x + dx/2 on the front face, z + dx/2 on the top).
 
 Run from pvpython (plugin from $MESHFREE_PLUGIN):
@@ -56,6 +56,8 @@ def load_plugin(namespace):
         sys.exit("load the MeshFree plugin, or set MESHFREE_PLUGIN to "
                  "build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so")
     simple.LoadPlugin(path, remote=False, ns=namespace)
+    if "SPHFluidWithObstacles" not in namespace and hasattr(simple, "SPHFluidWithObstacles"):
+        namespace["SPHFluidWithObstacles"] = simple.SPHFluidWithObstacles
 
 
 def make_scene(namespace, dx, end, interval, solver, viscosity=1e-3):
@@ -85,8 +87,12 @@ def probes(out, dx):
     p = np.asarray(out.PointData["Pressure"])
     row = {}
     for name, gx in GAUGES.items():
-        near = (np.abs(x[:, 0] - gx) <= dx) & (np.abs(x[:, 1] - GAUGE_Y) <= dx)
-        row[name] = float(x[near, 2].max() + 0.5 * dx) if near.any() else 0.0
+        # The water depth at the gauge: the particles' volume dx^3 spread by a tent of half-width 2 dx in x and in
+        # y (the tents of a lattice's columns sum to (2 dx / dx)^2 = 4 at any offset), so that a splash adds its
+        # volume, not its height, and a particle crossing the gauge's patch changes the depth smoothly.
+        w = np.clip(1.0 - np.abs(x[:, 0] - gx) / (2.0 * dx), 0.0, None) * \
+            np.clip(1.0 - np.abs(x[:, 1] - GAUGE_Y) / (2.0 * dx), 0.0, None)
+        row[name] = float(np.sum(w)) * dx / 4.0
     h = 2.0 * dx
     for name, (sx, sy, sz, normal) in SENSORS.items():
         q = np.array([sx + (0.5 * dx if normal == "x" else 0.0), sy, sz + (0.5 * dx if normal == "z" else 0.0)])
@@ -102,6 +108,7 @@ def probes(out, dx):
 
 def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True):
     fluid = make_scene(namespace, dx, end, interval, solver)
+    fluid.UpdatePipelineInformation()  # the output times of these properties, not of the defaults
     times = list(fluid.TimestepValues)
     names = list(GAUGES) + list(SENSORS)
     rows = []
@@ -120,8 +127,8 @@ def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True
     if out_csv:
         with open(out_csv, "w", newline="") as f:
             f.write("# SPHERIC Test 2 with MeshFree SPH Fluid: dx = %g m, solver %s, viscosity 1e-3 Pa s\n" % (dx, solver))
-            f.write("# heights: highest particle within dx of the gauge line + dx/2; pressures: Shepard average "
-                    "within h = 2 dx of the probe moved dx/2 into the fluid\n")
+            f.write("# heights: particle volume spread by a tent of half-width 2 dx in x and y around the gauge; "
+                    "pressures: Shepard average within h = 2 dx of the probe moved dx/2 into the fluid\n")
             w = csv.DictWriter(f, fieldnames=["t"] + names + ["particles", "wall_s"])
             w.writeheader()
             for row in rows:
