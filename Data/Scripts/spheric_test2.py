@@ -17,7 +17,8 @@ Run from pvpython (plugin from $MESHFREE_PLUGIN):
   pvpython --no-mpi Data/Scripts/spheric_test2.py --dx 0.04 --end 6 --solver DFSPH --out spheric2_dx0.04.csv
 or from the GUI: View > Python Shell > Run Script (with the MeshFree plugin loaded). Without command-line options
 the script runs a coarse 1 s variant (dx = 0.04 m, DFSPH), shows the fluid and writes ~/spheric2.csv.
-Output: a CSV with one row per output time: t, H1..H4 (m), P1..P8 (Pa), particles, wall-clock seconds so far.
+Output: a CSV with one row per output time: t, H1..H4 (m), P1..P8 (Pa), particles, steps taken and wall-clock
+seconds so far.
 """
 import argparse
 import csv
@@ -119,6 +120,8 @@ def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True
         row = {"t": t}
         row.update(probes(out, dx))
         row["particles"] = out.GetNumberOfPoints()
+        fluid.UpdatePropertyInformation()
+        row["steps"] = fluid.GetProperty("StepsTaken").GetElement(0)
         row["wall_s"] = time.time() - start
         rows.append(row)
         if progress:
@@ -129,7 +132,7 @@ def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True
             f.write("# SPHERIC Test 2 with MeshFree SPH Fluid: dx = %g m, solver %s, viscosity 1e-3 Pa s\n" % (dx, solver))
             f.write("# heights: particle volume spread by a tent of half-width 2 dx in x and y around the gauge; "
                     "pressures: Shepard average within h = 2 dx of the probe moved dx/2 into the fluid\n")
-            w = csv.DictWriter(f, fieldnames=["t"] + names + ["particles", "wall_s"])
+            w = csv.DictWriter(f, fieldnames=["t"] + names + ["particles", "steps", "wall_s"])
             w.writeheader()
             for row in rows:
                 w.writerow(row)

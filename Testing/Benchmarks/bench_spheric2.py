@@ -2,7 +2,7 @@
 
 Runs Data/Scripts/spheric_test2.py (the scene and its probes) for each solver and resolution, in the same pvpython
 process, one after the other, and reports for each run:
-  * simulated seconds per wall-clock second (the whole run, probes included; particles; steps are not exposed),
+  * simulated seconds per wall-clock second (the whole run, probes included), particles and steps,
   * the normalised mean absolute error of H2 and H4 against the experiment at the reference instants below
     (mean |H_sim - H_exp| / max H_exp over those instants; the simulation's series is interpolated linearly),
   * the P1 impact peak (largest P1 between 0.3 and 1.0 s) and its time, against the experiment's,
@@ -72,6 +72,7 @@ def metrics(rows, end):
     out["particles_start"] = rows[0]["particles"]
     out["particles_end"] = rows[-1]["particles"]
     out["mass_drift"] = abs(rows[-1]["particles"] - rows[0]["particles"]) / max(1, rows[0]["particles"])
+    out["steps"] = rows[-1].get("steps")
     out["wall_s"] = rows[-1]["wall_s"]
     out["sim_per_wall"] = float(t[-1] / rows[-1]["wall_s"]) if rows[-1]["wall_s"] > 0 else None
     return out
