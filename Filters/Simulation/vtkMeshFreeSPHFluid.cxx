@@ -209,6 +209,10 @@ int vtkMeshFreeSPHFluid::RequestData(
   std::copy(this->Gravity, this->Gravity + 3, p.Gravity);
   p.TimeStep = this->TimeStep;
   p.CFLNumber = this->CFLNumber;
+  p.Solver = static_cast<meshfree::SPHSolver>(this->Solver);
+  p.DensityTolerance = this->DensityTolerance;
+  p.DivergenceTolerance = this->DivergenceTolerance;
+  p.MaximumIterations = this->MaximumIterations;
 
   // The obstacles, whole on every rank: under MPI each rank holds a piece (collective: every rank gathers, also
   // with an empty piece). The canonical order makes the triangles, and so the simulation, the same bits whatever
@@ -226,7 +230,8 @@ int vtkMeshFreeSPHFluid::RequestData(
   key << std::hexfloat << p.Dimension << ' ' << p.ParticleSpacing << ' ' << p.SmoothingLength << ' '
       << p.RestDensity << ' ' << p.GasStiffness << ' ' << this->EquationOfState << ' ' << this->KernelPair << ' '
       << p.Viscosity << ' ' << p.ArtificialViscosity << ' ' << p.SurfaceTension << ' ' << p.TimeStep << ' ' << p.CFLNumber << ' '
-      << this->OutputInterval;
+      << this->OutputInterval << ' ' << this->Solver << ' ' << p.DensityTolerance << ' ' << p.DivergenceTolerance << ' '
+      << p.MaximumIterations;
   for (int i = 0; i < 6; ++i)
   {
     key << ' ' << p.FluidBounds[i] << ' ' << p.DomainBounds[i] << ' ' << (i < 3 ? p.Gravity[i] : 0.0);
@@ -271,6 +276,7 @@ int vtkMeshFreeSPHFluid::RequestData(
   std::string backend = this->SelectBackend(static_cast<vtkIdType>(state.Size()));
   bool advanced = false, onDevice = false;
   const long reducedBefore = impl.Solver.ReducedSteps();
+  const long unconvergedBefore = impl.Solver.UnconvergedSteps();
   const long last = between ? step + 1 : step; // k = step + 1 stands for the partial interval
   for (long k = found + 1; k <= last; ++k)
   {
@@ -307,6 +313,12 @@ int vtkMeshFreeSPHFluid::RequestData(
   if (advanced)
   {
     backend = onDevice ? "CUDA (" + meshfree::cuda::DeviceName() + ")" : CPUBackend();
+  }
+  if (impl.Solver.UnconvergedSteps() > unconvergedBefore)
+  {
+    vtkWarningMacro("SPH Fluid: the DFSPH solves did not reach DensityTolerance / DivergenceTolerance within "
+      << this->MaximumIterations << " iterations on " << impl.Solver.UnconvergedSteps() - unconvergedBefore
+      << " steps (raise MaximumIterations or the tolerances; a tolerance of 0 is never reached)");
   }
   if (impl.Solver.ReducedSteps() > reducedBefore)
   {
@@ -385,6 +397,40 @@ int vtkMeshFreeSPHFluid::RequestData(
   ran->SetName("Backend");
   ran->InsertNextValue(backend);
   output->GetFieldData()->AddArray(ran);
+  // The solver and what it did over the output interval that ended at this state (SPHSolverReport).
+  vtkNew<vtkStringArray> solverName;
+  solverName->SetName("Solver");
+  solverName->InsertNextValue(this->Solver == SOLVER_DFSPH ? "DFSPH" : "WCSPH");
+  output->GetFieldData()->AddArray(solverName);
+  const meshfree::SPHSolverReport& report = state.Report;
+  const double steps = report.Steps > 0 ? static_cast<double>(report.Steps) : 1.0;
+  vtkNew<vtkDoubleArray> densityIterations, divergenceIterations, densityError;
+  densityIterations->SetName("DensityIterations");
+  densityIterations->InsertNextValue(report.LastDensityIterations);
+  densityIterations->InsertNextValue(static_cast<double>(report.DensityIterations) / steps);
+  divergenceIterations->SetName("DivergenceIterations");
+  divergenceIterations->InsertNextValue(report.LastDivergenceIterations);
+  divergenceIterations->InsertNextValue(static_cast<double>(report.DivergenceIterations) / steps);
+  densityError->SetName("AverageDensityError");
+  if (this->Solver == SOLVER_DFSPH)
+  {
+    densityError->InsertNextValue(report.AverageDensityError);
+    densityError->InsertNextValue(report.MaxAverageDensityError);
+  }
+  else
+  {
+    double compression = 0.0;
+    for (meshfree::Index i = 0; i < state.Size(); ++i)
+    {
+      compression += std::max(state.Density[i] / this->RestDensity - 1.0, 0.0);
+    }
+    compression /= static_cast<double>(std::max<meshfree::Index>(1, state.Size()));
+    densityError->InsertNextValue(compression);
+    densityError->InsertNextValue(compression);
+  }
+  output->GetFieldData()->AddArray(densityIterations);
+  output->GetFieldData()->AddArray(divergenceIterations);
+  output->GetFieldData()->AddArray(densityError);
   return 1;
 }
 
@@ -454,4 +500,8 @@ void vtkMeshFreeSPHFluid::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ComputeNeighborCount: " << this->ComputeNeighborCount << "\n";
   os << indent << "CacheSize: " << this->CacheSize << "\n";
   os << indent << "Backend: " << this->Backend << "\n";
+  os << indent << "Solver: " << this->Solver << "\n";
+  os << indent << "DensityTolerance: " << this->DensityTolerance << "\n";
+  os << indent << "DivergenceTolerance: " << this->DivergenceTolerance << "\n";
+  os << indent << "MaximumIterations: " << this->MaximumIterations << "\n";
 }

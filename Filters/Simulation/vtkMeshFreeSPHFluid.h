@@ -20,7 +20,11 @@
  * `SPHFluidWithObstacles`, whose required input is this port.
  *
  * Output: vtkPolyData, one vertex per particle, point arrays `Velocity` (3), `Density`, `Pressure`, `Id`
- * (stable across time), and on request `Acceleration` (3) and `NeighborCount`.
+ * (stable across time), and on request `Acceleration` (3) and `NeighborCount`. Field data: `Backend` (what ran),
+ * `Solver` ("WCSPH" or "DFSPH"), and for the output interval that ended at this state `DensityIterations` and
+ * `DivergenceIterations` (2 values each: the last step's, and the mean per step), `AverageDensityError` (2 values:
+ * the last step's and the largest over the interval; DFSPH: the density solve's average compression, a fraction of
+ * ρ0; WCSPH: the mean of max(ρ/ρ0 − 1, 0) over the particles, iterations 0).
  *
  * Pieces (MPI: pvbatch, pvserver): every rank simulates the whole fluid (the core gives the same bits whatever the
  * thread count) and outputs only the particles whose index lies in its contiguous share of [0, n), chosen by
@@ -159,6 +163,41 @@ public:
   ///@}
 
   ///@{
+  /**
+   * The pressure solver: 0 'WCSPH' (default; weakly compressible, the equation of state above), 1 'DFSPH'
+   * (divergence-free SPH, Bender & Koschier 2015/2017: incompressible, a density and a divergence solve per step,
+   * the step from the velocity alone; see Filters/Core/SPH/SPHDivergenceFree.cxx). DFSPH runs on the CPU only: with
+   * Backend CUDA it warns and the CPU runs. EquationOfState and GasStiffness do not apply to DFSPH (GasStiffness
+   * still sets the sound speed of the artificial viscosity).
+   */
+  enum SolverType
+  {
+    SOLVER_WCSPH = 0,
+    SOLVER_DFSPH = 1
+  };
+  vtkSetClampMacro(Solver, int, SOLVER_WCSPH, SOLVER_DFSPH);
+  vtkGetMacro(Solver, int);
+  ///@}
+
+  ///@{
+  /** DFSPH: the average compression allowed after the density solve, in percent of ρ0. Default 0.01. */
+  vtkSetMacro(DensityTolerance, double);
+  vtkGetMacro(DensityTolerance, double);
+  ///@}
+
+  ///@{
+  /** DFSPH: the average (dρ/dt)·dt/ρ0 allowed after the divergence solve, in percent. Default 0.1. */
+  vtkSetMacro(DivergenceTolerance, double);
+  vtkGetMacro(DivergenceTolerance, double);
+  ///@}
+
+  ///@{
+  /** DFSPH: the most iterations of each solve per step. Default 100. */
+  vtkSetMacro(MaximumIterations, int);
+  vtkGetMacro(MaximumIterations, int);
+  ///@}
+
+  ///@{
   /** Number of simulation states kept in the time cache (≥ 2). Default 16. */
   vtkSetClampMacro(CacheSize, int, 2, 100000);
   vtkGetMacro(CacheSize, int);
@@ -232,6 +271,10 @@ protected:
   bool ComputeNeighborCount = false;
   int CacheSize = 16;
   int Backend = BACKEND_AUTO;
+  int Solver = SOLVER_WCSPH;
+  double DensityTolerance = 0.01;
+  double DivergenceTolerance = 0.1;
+  int MaximumIterations = 100;
   long StepsTaken = 0;
 
 private:

@@ -282,6 +282,20 @@ void SPHFluid::Reorder(SPHState& state)
     id[s] = state.Id[order[s]];
   }
   state.Id.swap(id);
+  auto permute1 = [&](std::vector<double>& a) {
+    if (static_cast<Index>(a.size()) != n)
+    {
+      return;
+    }
+    std::vector<double> b(n);
+    for (Index s = 0; s < n; ++s)
+    {
+      b[s] = a[order[s]];
+    }
+    a.swap(b);
+  };
+  permute1(state.DensityStiffness); // DFSPH's warm start (empty for WCSPH)
+  permute1(state.DivergenceStiffness);
   // Density and pressure are recomputed by the next force evaluation.
 }
 
@@ -315,7 +329,6 @@ double SPHFluid::StableTimeStep(const SPHState& state, double lambda) const
 bool SPHFluid::ChooseStep(const SPHExtremes& e, double time, double targetTime, long steps, double& dt, bool& last)
 {
   const SPHParameters& p = this->Params;
-  const double remaining = targetTime - time;
   if (p.CFLNumber > 0.0)
   {
     dt = std::min(p.TimeStep, SPHStableStep(e, std::min(p.CFLNumber, StabilityLambda), this->Physics));
@@ -330,6 +343,13 @@ bool SPHFluid::ChooseStep(const SPHExtremes& e, double time, double targetTime, 
       ++this->ReducedStepCount;
     }
   }
+  return this->LandStep(time, targetTime, steps, dt, last);
+}
+
+bool SPHFluid::LandStep(double time, double targetTime, long steps, double& dt, bool& last)
+{
+  const SPHParameters& p = this->Params;
+  const double remaining = targetTime - time;
   if (!(dt > 0.0) || !std::isfinite(dt))
   {
     std::ostringstream s;
@@ -370,6 +390,14 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
   }
   this->LastBackend = SPHBackend::CPU;
   this->DeviceNote.clear();
+  if (p.Solver == SPHSolver::DFSPH)
+  {
+    if (this->RequestedBackend == SPHBackend::CUDA)
+    {
+      this->DeviceNote = "the DFSPH solver runs on the CPU only";
+    }
+    return this->AdvanceDivergenceFree(state, targetTime, progress);
+  }
   if (this->RequestedBackend == SPHBackend::CUDA)
   {
     bool declined = false;

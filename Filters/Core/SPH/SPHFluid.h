@@ -106,6 +106,13 @@ enum class SPHEquationOfState
   Tait = 1   ///< p = B ((rho/rho0)^7 - 1), Becker & Teschner 2007
 };
 
+/// Which pressure solver advances the fluid.
+enum class SPHSolver
+{
+  WCSPH = 0, ///< weakly compressible: equation of state, explicit leap-frog (the model above)
+  DFSPH = 1  ///< divergence-free SPH (Bender & Koschier 2015/2017): SPH/SPHDivergenceFree.cxx, CPU only
+};
+
 /// Which kernels give the density and the pressure force's gradient.
 enum class SPHKernelPair
 {
@@ -135,6 +142,23 @@ struct SPHParameters
   double BoundarySpacingFactor = 0.5; ///< obstacle surface sampling spacing / dx (inside test)
   int ReorderInterval = 25;           ///< steps between Z-order permutations of the particle arrays
   long MaximumStepsPerInterval = 2000000; ///< a call to Advance() fails rather than take more steps
+  SPHSolver Solver = SPHSolver::WCSPH;
+  double DensityTolerance = 0.01;   ///< DFSPH: average compression allowed after the density solve, in percent
+  double DivergenceTolerance = 0.1; ///< DFSPH: average (drho/dt) dt / rho0 allowed after the divergence solve, percent
+  int MaximumIterations = 100;      ///< DFSPH: iterations per solve (each solve also stops at its tolerance)
+};
+
+/// What the DFSPH solves did in the Advance() call that produced a state (all zero for WCSPH).
+struct SPHSolverReport
+{
+  long Steps = 0;                  ///< steps of that call
+  long DensityIterations = 0;      ///< summed over its steps
+  long DivergenceIterations = 0;   ///< summed over its steps
+  long UnconvergedSteps = 0;       ///< steps where a solve stopped at MaximumIterations above its tolerance
+  int LastDensityIterations = 0;   ///< of the last step
+  int LastDivergenceIterations = 0;
+  double AverageDensityError = 0.0;    ///< the last density solve's average compression (fraction of rho0)
+  double MaxAverageDensityError = 0.0; ///< the largest of those over the call's steps
 };
 
 /// Everything the future of a simulation depends on (positions, velocities, the last acceleration), plus the
@@ -149,6 +173,10 @@ struct SPHState
   std::vector<double> Density;      ///< n
   std::vector<double> Pressure;     ///< n
   std::vector<std::int64_t> Id;     ///< n, stable across time
+  /// DFSPH only (empty for WCSPH): the accumulated stiffness of each particle's last density solve (kappa, m^2/s^2;
+  /// pressure = rho kappa) and divergence solve (kappa dt, m^2/s): the warm start of the next step.
+  std::vector<double> DensityStiffness, DivergenceStiffness;
+  SPHSolverReport Report; ///< DFSPH: what the Advance() call that produced this state did
 
   Index Size() const { return static_cast<Index>(this->Id.size()); }
 };
@@ -207,7 +235,7 @@ public:
   ///@}
 
   /// Recomputes the density, pressure and acceleration of `state` at its positions and velocities (the force
-  /// evaluation of a step, on the CPU).
+  /// evaluation of a step, on the CPU; WCSPH).
   void UpdateDerived(SPHState& state) { this->ComputeAccelerations(state); }
 
   ///@{
@@ -227,6 +255,8 @@ public:
   const std::string& ErrorMessage() const { return this->Error; }
   /// Steps whose fixed TimeStep was above the stability limit and was reduced (since Setup()).
   long ReducedSteps() const { return this->ReducedStepCount; }
+  /// DFSPH steps where a solve stopped at MaximumIterations before reaching its tolerance (since Setup()).
+  long UnconvergedSteps() const { return this->UnconvergedStepCount; }
 
   const SPHParameters& Parameters() const { return this->Params; }
   double SupportRadius() const { return this->H; }
@@ -265,6 +295,25 @@ private:
   /// and normals only, never on the order of the samples (of the obstacle's triangles). -1 when there is none.
   Index ObstacleSample(const double* x, std::vector<Index>& ids, std::vector<double>& d2, double& depth) const;
   void FillConstants(); // Physics from the members below, at the end of Setup()
+  /// Cuts the step dt to land on targetTime (the last two steps share what remains); false with Error set when
+  /// the step is not finite or would need more than MaximumStepsPerInterval steps.
+  bool LandStep(double time, double targetTime, long steps, double& dt, bool& last);
+
+  // DFSPH (SPHDivergenceFree.cxx).
+  Status AdvanceDivergenceFree(SPHState& state, double targetTime, const ProgressFunction& progress);
+  /// Grid, neighbour lists, density, the pair gradient coefficients and the factors alpha at the state's positions.
+  void DivergenceFreeFields(SPHState& state);
+  /// Density (correct = false: divergence) solve on the velocities of `state`; returns the iterations, sets error.
+  int DivergenceFreeSolve(SPHState& state, double dt, bool density, double& error);
+  /// The DFSPH output fields of a state: density at its positions, pressure rho kappa, its stiffness arrays sized.
+  void DivergenceFreeOutput(SPHState& state);
+  bool ChooseDivergenceFreeStep(const SPHState& state, double time, double targetTime, long steps, double& dt,
+    bool& last);
+  std::vector<double> PairCoefficient, WallCoefficient; // m GradientNorm shape(r) of every fluid and wall pair
+  std::vector<double> Alpha, Kappa, KappaOverRho, OldCompression, OldVelocity, Smoothed;
+  void SmoothStiffness(const SPHState& state, const std::vector<double>& in, std::vector<double>& out) const;
+  double LatticeFactorSum = 0.0; // |sum G|^2 + sum |G|^2 of a lattice particle far from walls, for the alpha cutoff
+  long UnconvergedStepCount = 0;
 
   SPHParameters Params;
   std::vector<std::string> WarningList;

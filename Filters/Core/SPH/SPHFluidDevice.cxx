@@ -13,6 +13,10 @@ namespace meshfree
 std::string SPHFluid::DeviceDeclineReason() const
 {
   std::string reason;
+  if (this->Params.Solver == SPHSolver::DFSPH)
+  {
+    return "the DFSPH solver runs on the CPU only"; // decided before the CUDA runtime is probed
+  }
   if (!cuda::Available(&reason))
   {
     return reason;

@@ -71,6 +71,7 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
   this->WarningList.clear();
   this->Error.clear();
   this->ReducedStepCount = 0;
+  this->UnconvergedStepCount = 0;
   auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
   if (p.Dimension != 2 && p.Dimension != 3)
   {
@@ -136,6 +137,32 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
     this->WarningList.push_back("KernelPair 'Mueller' (poly6 density, spiky gradient, as in the thesis) does not "
                                 "conserve energy: the fluid gains energy unless the viscosity is large; 'Spiky' "
                                 "is the physically consistent choice");
+  }
+  if (p.Solver != SPHSolver::WCSPH && p.Solver != SPHSolver::DFSPH)
+  {
+    fail("Solver must be WCSPH (0) or DFSPH (1)");
+  }
+  if (p.Solver == SPHSolver::DFSPH)
+  {
+    if (!(p.DensityTolerance >= 0.0) || !std::isfinite(p.DensityTolerance) || !(p.DivergenceTolerance >= 0.0) ||
+      !std::isfinite(p.DivergenceTolerance))
+    {
+      fail("DensityTolerance and DivergenceTolerance must be finite and >= 0 (percent)");
+    }
+    if (p.MaximumIterations < 1)
+    {
+      fail("MaximumIterations must be at least 1");
+    }
+    if (p.DensityTolerance == 0.0 || p.DivergenceTolerance == 0.0)
+    {
+      this->WarningList.push_back("a DFSPH tolerance of 0 cannot be reached in floating point: every such solve "
+                                  "runs MaximumIterations iterations (0.01 % density, 0.1 % divergence are usual)");
+    }
+    if (p.DensityTolerance > 1.0)
+    {
+      this->WarningList.push_back("DensityTolerance above 1 % lets the DFSPH fluid compress visibly (0.01 to 0.1 % "
+                                  "is usual)");
+    }
   }
   if (!(p.BoundarySpacingFactor > 0.0) || p.ReorderInterval < 1 || p.MaximumStepsPerInterval < 1)
   {
@@ -288,6 +315,25 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
     this->GradientNorm *= this->GradientCorrection;
     this->ViscLap *= this->ViscCorrection;
     this->Poly6 *= sc > 0.0 ? 1.0 / sc : 1.0; // colour field
+    // DFSPH: sum_j |m grad W_ij|^2 of an interior lattice particle (sum_j m grad W_ij vanishes there), the scale
+    // below which a particle's factor alpha is set to 0 (too few neighbours to be pushed by pressure).
+    double lattice = 0.0;
+    for (int k = -reach; k <= reach; ++k)
+    {
+      for (int j = (d == 3 ? -reach : 0); j <= (d == 3 ? reach : 0); ++j)
+      {
+        for (int i = -reach; i <= reach; ++i)
+        {
+          const double r2 = (i * i + j * j + k * k) * dx * dx;
+          if (r2 > 0.0 && r2 < this->H2)
+          {
+            const double g = this->Mass * this->GradientNorm * this->GradientShape(r2, std::sqrt(r2));
+            lattice += g * g * r2;
+          }
+        }
+      }
+    }
+    this->LatticeFactorSum = lattice;
   }
 
   // Boundary (dummy) particles: a shell behind the container walls and a layer inside every obstacle, as
@@ -512,15 +558,28 @@ SPHState SPHFluid::InitialState()
         p.FluidBounds[4 + ((corner >> 2) & 1)] };
       top = std::max(top, c[0] * up[0] + c[1] * up[1] + c[2] * up[2]);
     }
-    const double ratio = gNorm / (this->K * this->CompressionResponse);
+    // DFSPH: the fluid is incompressible, the block starts on its lattice.
+    const double ratio =
+      p.Solver == SPHSolver::DFSPH ? 0.0 : gNorm / (this->K * this->CompressionResponse);
     auto compress = [ratio](double depth) {
       return ratio > 0.0 ? 2.0 * depth / (std::sqrt(1.0 + 2.0 * ratio * depth) + 1.0) : depth;
     };
     double deepest = 0.0;
+    if (p.Solver == SPHSolver::DFSPH)
+    {
+      state.DensityStiffness.assign(n, 0.0);
+    }
     for (Index i = 0; i < n; ++i)
     {
       const double* x = &state.Position[3 * i];
-      deepest = std::max(deepest, top - (x[0] * up[0] + x[1] * up[1] + x[2] * up[2]));
+      const double depth = top - (x[0] * up[0] + x[1] * up[1] + x[2] * up[2]);
+      deepest = std::max(deepest, depth);
+      if (p.Solver == SPHSolver::DFSPH)
+      {
+        // DFSPH: the hydrostatic kappa = p / rho = |g| depth, the warm start of the first density solve (the
+        // pressure the tank holds before its gate opens).
+        state.DensityStiffness[i] = gNorm * std::max(depth, 0.0);
+      }
     }
     const double settle = deepest - compress(deepest); // the deepest particles keep their place
     for (Index i = 0; i < n; ++i)
@@ -538,7 +597,14 @@ SPHState SPHFluid::InitialState()
   state.Acceleration.assign(3 * n, 0.0);
   state.Density.assign(n, p.RestDensity);
   state.Pressure.assign(n, 0.0);
-  this->ComputeAccelerations(state);
+  if (p.Solver == SPHSolver::DFSPH)
+  {
+    this->DivergenceFreeOutput(state);
+  }
+  else
+  {
+    this->ComputeAccelerations(state);
+  }
   return state;
 }
 

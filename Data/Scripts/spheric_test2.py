@@ -1,0 +1,163 @@
+"""SPHERIC Test 2 (Kleefsman et al. 2005, MARIN): a dam break onto a box, with the experiment's probes.
+
+Geometry (SPHERIC Test 2 description, as reproduced in ../../README.md's SPH section):
+  tank 3.22 x 1 x 1 m; water column x in [1.992, 3.22] m, full width, 0.55 m deep; box 0.161 x 0.403 x 0.161 m
+  at x in [0.6635, 0.8245], y in [0.2955, 0.6985] on the floor.
+Probes:
+  water heights H1-H4 at x = 0.496, 0.992, 1.488, 2.638 m (y = 0.5: the tank's centre line);
+  pressures P1-P4 on the box's front face (x = 0.8245, y = 0.471, z = 0.021, 0.061, 0.101, 0.141 m) and P5-P8 on
+  its top (z = 0.161, y = 0.471, x = 0.8035, 0.7635, 0.7235, 0.6835 m).
+The column is placed on the tank's lattice (its length rounded to a whole number of spacings from the far wall).
+Estimators (this script's choices, recorded in the CSV header): a water height is the water depth at the gauge, the
+particles' volume dx^3 spread by a tent of half-width 2 dx in x and in y (a splash adds its volume, not its
+height); a pressure is the Shepard (kernel-weighted) average of the particle pressures within the support radius h = 2 dx
+of the probe point moved half a spacing into the fluid (x + dx/2 on the front face, z + dx/2 on the top).
+
+Run from pvpython (plugin from $MESHFREE_PLUGIN):
+  pvpython --no-mpi Data/Scripts/spheric_test2.py --dx 0.04 --end 6 --solver DFSPH --out spheric2_dx0.04.csv
+or from the GUI: View > Python Shell > Run Script (with the MeshFree plugin loaded). Without command-line options
+the script runs a coarse 1 s variant (dx = 0.04 m, DFSPH), shows the fluid and writes ~/spheric2.csv.
+Output: a CSV with one row per output time: t, H1..H4 (m), P1..P8 (Pa), particles, steps taken and wall-clock
+seconds so far.
+"""
+import argparse
+import csv
+import os
+import sys
+import time
+
+import numpy as np
+from paraview import simple
+from paraview import servermanager as sm
+from vtkmodules.numpy_interface import dataset_adapter as dsa
+
+TANK = [0.0, 3.22, 0.0, 1.0, 0.0, 1.0]
+WATER = [1.992, 3.22, 0.0, 1.0, 0.0, 0.55]
+BOX = [0.6635, 0.8245, 0.2955, 0.6985, 0.0, 0.161]
+GAUGES = {"H1": 0.496, "H2": 0.992, "H3": 1.488, "H4": 2.638}
+GAUGE_Y = 0.5
+SENSORS = {
+    "P1": (0.8245, 0.471, 0.021, "x"), "P2": (0.8245, 0.471, 0.061, "x"),
+    "P3": (0.8245, 0.471, 0.101, "x"), "P4": (0.8245, 0.471, 0.141, "x"),
+    "P5": (0.8035, 0.471, 0.161, "z"), "P6": (0.7635, 0.471, 0.161, "z"),
+    "P7": (0.7235, 0.471, 0.161, "z"), "P8": (0.6835, 0.471, 0.161, "z"),
+}
+
+
+def load_plugin(namespace):
+    """Makes SPHFluidWithObstacles available in `namespace`: already there, in paraview.simple (the GUI, with the
+    plugin loaded), or loaded from $MESHFREE_PLUGIN."""
+    if "SPHFluidWithObstacles" in namespace:
+        return
+    if hasattr(simple, "SPHFluidWithObstacles"):
+        namespace["SPHFluidWithObstacles"] = simple.SPHFluidWithObstacles
+        return
+    path = os.environ.get("MESHFREE_PLUGIN")
+    if not path or not os.path.exists(path):
+        sys.exit("load the MeshFree plugin, or set MESHFREE_PLUGIN to "
+                 "build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so")
+    simple.LoadPlugin(path, remote=False, ns=namespace)
+    if "SPHFluidWithObstacles" not in namespace and hasattr(simple, "SPHFluidWithObstacles"):
+        namespace["SPHFluidWithObstacles"] = simple.SPHFluidWithObstacles
+
+
+def make_scene(namespace, dx, end, interval, solver, viscosity=1e-3):
+    """The Test 2 scene as an SPH Fluid With Obstacles proxy (and the box source it flows around)."""
+    box = simple.Box(XLength=BOX[1] - BOX[0], YLength=BOX[3] - BOX[2], ZLength=BOX[5] - BOX[4],
+                     Center=[0.5 * (BOX[0] + BOX[1]), 0.5 * (BOX[2] + BOX[3]), 0.5 * (BOX[4] + BOX[5])])
+    surface = simple.Triangulate(Input=box)
+    fluid = namespace["SPHFluidWithObstacles"](Obstacles=surface)
+    fluid.Dimension = 3
+    # The column on the tank's lattice: round(1.228 / dx) particles long from the far wall (1.24 m at dx = 0.04,
+    # 1.22 m at 0.02). Started at x = 1.992 instead, the last particles would sit 0.2 dx from the wall at dx = 0.04.
+    length = round((WATER[1] - WATER[0]) / dx) * dx
+    fluid.FluidBounds = [TANK[1] - length] + WATER[1:]
+    fluid.DomainBounds = TANK
+    fluid.ParticleSpacing = dx
+    fluid.Viscosity = viscosity
+    fluid.Solver = solver
+    fluid.EndTime = end
+    fluid.OutputInterval = interval
+    fluid.CacheSize = 2  # the probes are read as the run goes: no need to keep states
+    return fluid
+
+
+def probes(out, dx):
+    """H1-H4 and P1-P8 of one output state (see the module docstring for the estimators)."""
+    x = np.asarray(out.Points)
+    p = np.asarray(out.PointData["Pressure"])
+    row = {}
+    for name, gx in GAUGES.items():
+        # The water depth at the gauge: the particles' volume dx^3 spread by a tent of half-width 2 dx in x and in
+        # y (the tents of a lattice's columns sum to (2 dx / dx)^2 = 4 at any offset), so that a splash adds its
+        # volume, not its height, and a particle crossing the gauge's patch changes the depth smoothly.
+        w = np.clip(1.0 - np.abs(x[:, 0] - gx) / (2.0 * dx), 0.0, None) * \
+            np.clip(1.0 - np.abs(x[:, 1] - GAUGE_Y) / (2.0 * dx), 0.0, None)
+        row[name] = float(np.sum(w)) * dx / 4.0
+    h = 2.0 * dx
+    for name, (sx, sy, sz, normal) in SENSORS.items():
+        q = np.array([sx + (0.5 * dx if normal == "x" else 0.0), sy, sz + (0.5 * dx if normal == "z" else 0.0)])
+        r2 = np.sum((x - q) ** 2, axis=1)
+        inside = r2 < h * h
+        if inside.any():
+            w = (h - np.sqrt(r2[inside])) ** 3  # the spiky density kernel's shape
+            row[name] = float(np.sum(w * p[inside]) / np.sum(w))
+        else:
+            row[name] = 0.0
+    return row
+
+
+def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True):
+    fluid = make_scene(namespace, dx, end, interval, solver)
+    fluid.UpdatePipelineInformation()  # the output times of these properties, not of the defaults
+    times = list(fluid.TimestepValues)
+    names = list(GAUGES) + list(SENSORS)
+    rows = []
+    start = time.time()
+    for t in times:
+        fluid.UpdatePipeline(t)
+        out = dsa.WrapDataObject(sm.Fetch(fluid))
+        row = {"t": t}
+        row.update(probes(out, dx))
+        row["particles"] = out.GetNumberOfPoints()
+        fluid.UpdatePropertyInformation()
+        row["steps"] = fluid.GetProperty("StepsTaken").GetElement(0)
+        row["wall_s"] = time.time() - start
+        rows.append(row)
+        if progress:
+            print("t = %.3f s  H2 = %.3f  H4 = %.3f  P1 = %.0f Pa  (%.0f s)" % (t, row["H2"], row["H4"], row["P1"],
+                                                                             row["wall_s"]), flush=True)
+    if out_csv:
+        with open(out_csv, "w", newline="") as f:
+            f.write("# SPHERIC Test 2 with MeshFree SPH Fluid: dx = %g m, solver %s, viscosity 1e-3 Pa s\n" % (dx, solver))
+            f.write("# heights: particle volume spread by a tent of half-width 2 dx in x and y around the gauge; "
+                    "pressures: Shepard average within h = 2 dx of the probe moved dx/2 into the fluid\n")
+            w = csv.DictWriter(f, fieldnames=["t"] + names + ["particles", "steps", "wall_s"])
+            w.writeheader()
+            for row in rows:
+                w.writerow(row)
+    if show:
+        simple.Show(fluid)
+        simple.Render()
+    return rows
+
+
+def main():
+    if len(sys.argv) <= 1:
+        # No options: the GUI's Run Script (or a bare pvpython call): a coarse 1 s run, shown, CSV in the home folder.
+        load_plugin(globals())
+        run(globals(), 0.04, 1.0, 0.02, "DFSPH", os.path.join(os.path.expanduser("~"), "spheric2.csv"), show=True)
+        return
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--dx", type=float, default=0.04)
+    parser.add_argument("--end", type=float, default=6.0)
+    parser.add_argument("--interval", type=float, default=0.02)
+    parser.add_argument("--solver", default="DFSPH", choices=["WCSPH", "DFSPH"])
+    parser.add_argument("--out", default="spheric2.csv")
+    args = parser.parse_args()
+    load_plugin(globals())
+    run(globals(), args.dx, args.end, args.interval, args.solver, args.out)
+
+
+if __name__ == "__main__":
+    main()

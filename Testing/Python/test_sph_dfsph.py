@@ -1,0 +1,82 @@
+"""SPH Fluid with Solver 'DFSPH' from pvpython: the same arrays as WCSPH, the solver's field data, the time cache,
+the obstacle variant, and the CUDA request falling back to the CPU."""
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import meshfree_test  # noqa: E402
+
+meshfree_test.load(globals())
+
+src = SPHFluid(Dimension=2, ParticleSpacing=0.01, FluidBounds=[0, 0.1, 0, 0, 0, 0.2],
+               DomainBounds=[0, 0.4, 0, 0, 0, 0.3], Viscosity=0.01, EndTime=0.1, OutputInterval=0.025)
+src.Solver = 'DFSPH'
+src.DensityTolerance = 0.01
+src.DivergenceTolerance = 0.1
+src.MaximumIterations = 100
+
+for t in (0.1, 0.05, 0.0):
+    out = meshfree_test.fetch(src, t)
+    n = out.GetNumberOfPoints()
+    assert n == 200, n
+    for name in ("Velocity", "Density", "Pressure", "Id"):
+        assert name in out.PointData.keys(), name
+    for name in ("Velocity", "Density", "Pressure"):
+        assert np.all(np.isfinite(np.asarray(out.PointData[name]))), name
+    x = np.asarray(out.Points)
+    assert np.all((x[:, 0] > 0) & (x[:, 0] < 0.4) & (x[:, 2] > 0) & (x[:, 2] < 0.3))
+    fd = out.GetFieldData()
+    assert fd.GetAbstractArray("Solver").GetValue(0) == "DFSPH"
+    for name in ("DensityIterations", "DivergenceIterations", "AverageDensityError"):
+        assert fd.GetArray(name) is not None and fd.GetArray(name).GetNumberOfTuples() == 2, name
+
+out = meshfree_test.fetch(src, 0.1)
+fd = out.GetFieldData()
+assert fd.GetArray("DensityIterations").GetValue(1) > 0  # the mean per step over the interval
+error = fd.GetArray("AverageDensityError").GetValue(0)
+assert 0 <= error <= 0.0001 + 1e-12, error  # DensityTolerance 0.01 % reached
+assert np.asarray(out.Points)[:, 0].max() > 0.1  # the column has started to spread
+rho = np.asarray(out.PointData["Density"])
+assert rho.max() < 1000 * 1.01, rho.max()  # incompressible: no particle compressed by 1 %
+
+
+def steps_taken():
+    src.UpdatePropertyInformation()
+    return src.GetProperty("StepsTaken").GetElement(0)
+
+
+before = steps_taken()
+for t in (0.025, 0.075, 0.1, 0.0):
+    meshfree_test.fetch(src, t)
+assert steps_taken() == before, (steps_taken(), before)  # served by the cache
+src.DensityTolerance = 0.02
+meshfree_test.fetch(src, 0.025)
+assert steps_taken() > before  # a solver property empties the cache
+
+# WCSPH reports the same field data (iterations 0).
+src.Solver = 'WCSPH'
+out = meshfree_test.fetch(src, 0.05)
+assert out.GetFieldData().GetAbstractArray("Solver").GetValue(0) == "WCSPH"
+assert out.GetFieldData().GetArray("DensityIterations").GetValue(0) == 0
+
+# CUDA requested: DFSPH runs on the CPU (and says so in Backend).
+src.Solver = 'DFSPH'
+src.Backend = 'CUDA'
+out = meshfree_test.fetch(src, 0.025)
+assert out.GetFieldData().GetAbstractArray("Backend").GetValue(0).startswith("CPU")
+src.Backend = 'Auto'
+
+# The obstacle variant: a box in the flow; no particle inside it.
+box = Box(XLength=0.04, YLength=0.1, ZLength=0.04, Center=[0.2, 0, 0.02])
+tri = Triangulate(Input=box)
+obs = SPHFluidWithObstacles(Obstacles=tri, Dimension=2, ParticleSpacing=0.01, FluidBounds=[0, 0.1, 0, 0, 0, 0.2],
+                            DomainBounds=[0, 0.4, 0, 0, 0, 0.3], EndTime=0.2, OutputInterval=0.1)
+obs.Solver = 'DFSPH'
+out = meshfree_test.fetch(obs, 0.2)
+x = np.asarray(out.Points)
+inside = (np.abs(x[:, 0] - 0.2) < 0.02 - 1e-6) & (x[:, 2] < 0.04 - 1e-6)
+assert not inside.any(), x[inside]
+assert out.GetFieldData().GetAbstractArray("Solver").GetValue(0) == "DFSPH"
+print("SPH Fluid DFSPH OK")
