@@ -418,7 +418,8 @@ std::vector<std::array<double, 9>> TriangleSet(const TriangleMesh& mesh)
 
 TEST(OrderIndependence, SurfaceOfAPermutedCloudHasTheSameTriangles)
 {
-  // A noisy torus (normals estimated and oriented: the whole path) and a lattice-like sphere (ties).
+  // A noisy torus (normals estimated and oriented: the whole path) and a lattice-like sphere (ties) with exact
+  // duplicates.
   const meshfree::testing::SurfaceCloud torus = meshfree::testing::SampleSurface(true, 3000, 0.002, 7);
   Cloud sphere;
   for (int i = 0; i < 24; ++i)
@@ -430,6 +431,10 @@ TEST(OrderIndependence, SurfaceOfAPermutedCloudHasTheSameTriangles)
       sphere.insert(sphere.end(), { std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
         std::cos(theta) });
     }
+  }
+  for (Index i = 0; i < 200; i += 7) // exact duplicates: merged (MLS, WLS) or kept (SPH)
+  {
+    sphere.insert(sphere.end(), sphere.begin() + 3 * i, sphere.begin() + 3 * i + 3);
   }
   // The torus with a hole (x > 0.7 cut away), filled: the filled part follows the winding number's tree.
   Cloud holed;
