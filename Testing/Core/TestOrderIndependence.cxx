@@ -9,10 +9,13 @@
 // the one with the smallest (x, y, z), whatever the order.
 #include "Approximation/Approximation.h"
 #include "Common/NeighborGrid.h"
+#include "Surface/SurfaceReconstruction.h"
+#include "SurfaceSamples.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -379,4 +382,104 @@ TEST(OrderIndependence, ApproximationOfAPermutedCloudIsBitwiseEqual)
     }
   }
   EXPECT_EQ(compared, 2 * (5 * 2 + 2) * 3);
+}
+
+namespace
+{
+/// The mesh's triangles as a set: each one's 9 vertex coordinates starting at its smallest vertex (the winding
+/// kept), sorted.
+std::vector<std::array<double, 9>> TriangleSet(const TriangleMesh& mesh)
+{
+  std::vector<std::array<double, 9>> set(mesh.NumberOfTriangles());
+  for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+  {
+    const double* v[3];
+    for (int c = 0; c < 3; ++c)
+    {
+      v[c] = &mesh.Points[3 * mesh.Triangles[3 * t + c]];
+    }
+    int first = 0;
+    for (int c = 1; c < 3; ++c)
+    {
+      if (std::lexicographical_compare(v[c], v[c] + 3, v[first], v[first] + 3))
+      {
+        first = c;
+      }
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      std::copy(v[(first + c) % 3], v[(first + c) % 3] + 3, set[t].begin() + 3 * c);
+    }
+  }
+  std::sort(set.begin(), set.end());
+  return set;
+}
+} // namespace
+
+TEST(OrderIndependence, SurfaceOfAPermutedCloudHasTheSameTriangles)
+{
+  // A noisy torus (normals estimated and oriented: the whole path) and a lattice-like sphere (ties) with exact
+  // duplicates.
+  const meshfree::testing::SurfaceCloud torus = meshfree::testing::SampleSurface(true, 3000, 0.002, 7);
+  Cloud sphere;
+  for (int i = 0; i < 24; ++i)
+  {
+    for (int j = 0; j < 48; ++j)
+    {
+      const double theta = M_PI * (i + 0.5) / 24.0;
+      const double phi = 2.0 * M_PI * j / 48.0;
+      sphere.insert(sphere.end(), { std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+        std::cos(theta) });
+    }
+  }
+  for (Index i = 0; i < 200; i += 7) // exact duplicates: merged (MLS, WLS) or kept (SPH)
+  {
+    sphere.insert(sphere.end(), sphere.begin() + 3 * i, sphere.begin() + 3 * i + 3);
+  }
+  // The torus with a hole (x > 0.7 cut away), filled: the filled part follows the winding number's tree.
+  Cloud holed;
+  for (Index i = 0; i < torus.Count(); ++i)
+  {
+    if (torus.Points[3 * i] <= 0.7)
+    {
+      holed.insert(holed.end(), torus.Points.begin() + 3 * i, torus.Points.begin() + 3 * i + 3);
+    }
+  }
+  int compared = 0;
+  const Cloud* clouds[] = { &torus.Points, &sphere, &holed };
+  for (const Cloud* cloud : clouds)
+  {
+    const std::string cloudName = cloud == &sphere ? "sphere" : cloud == &holed ? "holed torus, filled" : "torus";
+    for (SurfaceMethod method : { SurfaceMethod::MLS, SurfaceMethod::WLS, SurfaceMethod::SPH })
+    {
+      if (cloud == &holed && method == SurfaceMethod::SPH)
+      {
+        continue;
+      }
+      SurfaceOptions options;
+      options.Method = method;
+      options.HoleFilling = cloud == &holed ? HoleFillingMode::On : HoleFillingMode::Auto;
+      const std::string what = cloudName + " " + SurfaceMethodName(method);
+      auto run = [&](const Cloud& c) {
+        SurfaceInput input;
+        input.Points = c.data();
+        input.Count = Count(c);
+        SurfaceMesh mesh;
+        SurfaceReport report;
+        std::string error;
+        EXPECT_TRUE(ReconstructSurface(input, options, mesh, report, error)) << what << ": " << error;
+        return TriangleSet(mesh);
+      };
+      const auto want = run(*cloud);
+      EXPECT_GT(want.size(), 500u) << what;
+      for (unsigned seed : { 1u, 2u, 3u })
+      {
+        const auto got = run(Permute(*cloud, Permutation(Count(*cloud), seed), 3));
+        EXPECT_EQ(got.size(), want.size()) << what << ", permutation " << seed;
+        EXPECT_TRUE(got == want) << what << ", permutation " << seed; // bitwise: == on doubles, no NaN here
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, (2 * 3 + 2) * 3);
 }

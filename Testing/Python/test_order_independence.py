@@ -2,7 +2,8 @@
 radius, values, gradients and vtkValidPointMask on a grid and on a probe) and Point Neighbors give the same bits when
 the input points come in another order. The cloud is a Wavelet's cell centres - a lattice, where every point's k-th
 nearest neighbour is one of several at the same distance - and a random cloud; each is permuted 3 times with numpy
-and read back from a file (no Programmable Filter)."""
+and read back from a file (no Programmable Filter). Meshless Surface (MLS, WLS, SPH) of a noisy sphere and of 3
+permutations of it gives the same triangles (sorted vertex coordinates, bitwise) with the same values on them."""
 import os
 import sys
 
@@ -119,5 +120,48 @@ for cloud_name, xyz, arrays in (("lattice", lattice, lattice_arrays), ("random",
                      if not np.array_equal(got[name], values)]
     for reader in readers:
         simple.Delete(reader)
+
+
+def triangle_set(out):
+    """The surface's triangles as a set: each one's vertex coordinates from its smallest vertex on (winding kept),
+    the rows sorted; and the point arrays at those vertices in the same order."""
+    pts = np.asarray(out.Points, dtype=float)
+    conn = np.asarray(out.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+    rows, values = [], []
+    arrays = [np.asarray(out.PointData[name], dtype=float).reshape(len(pts), -1) for name in ("RTData", "V")]
+    for tri in conn:
+        first = min(range(3), key=lambda c: tuple(pts[tri[c]]))
+        order = [tri[(first + c) % 3] for c in range(3)]
+        rows.append(tuple(pts[order].ravel()))
+        values.append(tuple(np.concatenate([a[order].ravel() for a in arrays])))
+    index = sorted(range(len(rows)), key=lambda r: rows[r])
+    return np.array([rows[r] for r in index]), np.array([values[r] for r in index])
+
+
+# Meshless Surface (MLS, WLS, SPH): the same triangles, bit for bit, and the same values on them.
+rng = np.random.default_rng(9)
+sphere = rng.normal(size=(1500, 3))
+sphere /= np.linalg.norm(sphere, axis=1)[:, None]
+sphere += rng.normal(scale=0.003, size=sphere.shape)
+sphere_arrays = {"RTData": sphere[:, 0] + 2 * sphere[:, 2], "V": np.column_stack([sphere[:, 1], sphere[:, 0] ** 2])}
+perms = [np.arange(len(sphere))] + [np.random.default_rng(seed).permutation(len(sphere)) for seed in (1, 2, 3)]
+readers = [write_cloud(os.path.join(out_dir, f"order_sphere_{k}.vtp"), sphere[p],
+                       {name: values[p] for name, values in sphere_arrays.items()}) for k, p in enumerate(perms)]
+for method in ("MLS", "WLS", "SPH"):
+    results = []
+    for reader in readers:
+        f = MeshlessSurface(Input=reader, Method=method)
+        results.append(triangle_set(meshfree_test.fetch(f)))
+        simple.Delete(f)
+    assert len(results[0][0]) > 500, (method, len(results[0][0]))
+    for k in (1, 2, 3):
+        cases += 1
+        same = results[k][0].shape == results[0][0].shape and np.array_equal(results[k][0], results[0][0])
+        if not same:
+            failures.append(("sphere", "Meshless Surface", method, k, "triangles"))
+        elif not np.array_equal(results[k][1], results[0][1]):
+            failures.append(("sphere", "Meshless Surface", method, k, "point arrays"))
+for reader in readers:
+    simple.Delete(reader)
 print(f"{cases} permuted runs, largest difference {worst:.3g} of the range; {len(failures)} arrays differ")
 assert not failures, failures[:10]

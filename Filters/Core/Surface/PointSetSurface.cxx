@@ -105,6 +105,7 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
   {
     Tier& tier = this->Tiers[t];
     tier.Radius = bounds[t];
+    // Index order within cells is the main grid's sorted order here, itself by position: still order independent.
     tier.Grid.SetCellsByPosition(false);
     // Cells as wide as the query (the automatic size fills the bounding box: a scan's surface crosses few, crowded
     // cells, and the distance filter then saw about ten candidates per neighbour).

@@ -303,9 +303,8 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   const auto seconds = [](Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); };
   auto start = Clock::now();
   NeighborGrid grid;
-  // Kept in index order within cells until the surface's order independence is done (issue 24): the MLS surface
-  // bridging a scan's unseen underside changes topology with the position layout (test_meshless_surface).
-  grid.SetCellsByPosition(false);
+  // The default layout (each cell's points by position): every loop over the sorted points, the seeds, the fits'
+  // neighbour lists and sums follow the positions, not the input order (issue 24).
   grid.Build(input.Points, input.Count);
   report.InvalidPoints = grid.NumberOfInvalidPoints();
   if (grid.NumberOfValidPoints() == 0)
@@ -422,6 +421,9 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     for (size_t i = 0; i < areas.size(); ++i)
     {
       areas[i] = support[i] > 0.0 && !normals.Outlier[i] ? areas[i] : 0.0;
+    }
+    for (const Index i : grid.SortedOrder()) // summed in the grid's order, which depends on the positions only
+    {
       total += areas[i];
       for (int a = 0; a < 3; ++a)
       {

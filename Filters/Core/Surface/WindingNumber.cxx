@@ -168,8 +168,15 @@ Index WindingNumber::BuildNode(Index begin, Index end, std::vector<Item>& items)
   this->Nodes[id].Begin = begin;
   this->Nodes[id].End = end;
   this->Nodes[id].Left = this->Nodes[id].Right = -1;
+  // Ties by position, then by id (exact duplicates), so that the tree, and the order in which leaves and moments
+  // sum, depend on the set of points, not on their input order (issue 24).
+  const auto before = [](const Item& a, const Item& b) {
+    return std::lexicographical_compare(a.P, a.P + 3, b.P, b.P + 3) ||
+      (a.P[0] == b.P[0] && a.P[1] == b.P[1] && a.P[2] == b.P[2] && a.Id < b.Id);
+  };
   if (end - begin <= kLeafSize)
   {
+    std::sort(items.begin() + begin, items.begin() + end, before);
     return id;
   }
   double lo[3] = { items[begin].P[0], items[begin].P[1], items[begin].P[2] };
@@ -189,7 +196,9 @@ Index WindingNumber::BuildNode(Index begin, Index end, std::vector<Item>& items)
   }
   const Index mid = begin + (end - begin) / 2;
   std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-    [axis](const Item& a, const Item& b) { return a.P[axis] < b.P[axis] || (a.P[axis] == b.P[axis] && a.Id < b.Id); });
+    [axis, &before](const Item& a, const Item& b) {
+      return a.P[axis] < b.P[axis] || (a.P[axis] == b.P[axis] && before(a, b));
+    });
   const Index left = this->BuildNode(begin, mid, items);
   const Index right = this->BuildNode(mid, end, items);
   this->Nodes[id].Left = left;
