@@ -335,7 +335,7 @@ bool AgreeOnSelection(vtkMultiProcessController* controller, vtkIdType n, vtkPoi
   return n == 0;
 }
 
-/// Collective: Sum and Max over the controller's ranks for the core's distributed cloud.
+/// Collective: Sum, Max and Gather over the controller's ranks for the core's distributed cloud.
 meshfree::CloudPartition Partition(vtkMultiProcessController* controller, const unsigned char* owned)
 {
   meshfree::CloudPartition partition;
@@ -347,6 +347,24 @@ meshfree::CloudPartition Partition(vtkMultiProcessController* controller, const 
   partition.Sum = [reduce](double* values, int n) { reduce(values, n, vtkCommunicator::SUM_OP); };
   partition.Max = [reduce](double* values, int n) { reduce(values, n, vtkCommunicator::MAX_OP); };
   partition.Owned = owned;
+  partition.Gather = [controller](const std::vector<double>& mine, std::vector<double>& all) {
+    const int parts = controller->GetNumberOfProcesses();
+    const vtkIdType length = static_cast<vtkIdType>(mine.size());
+    std::vector<vtkIdType> lengths(static_cast<size_t>(parts), 0), offsets(static_cast<size_t>(parts), 0);
+    controller->AllGather(&length, lengths.data(), 1);
+    vtkIdType total = 0;
+    for (int p = 0; p < parts; ++p)
+    {
+      offsets[p] = total;
+      total += lengths[p];
+    }
+    all.assign(static_cast<size_t>(total), 0.0);
+    if (total > 0)
+    {
+      double none = 0.0;
+      controller->AllGatherV(mine.empty() ? &none : mine.data(), all.data(), length, lengths.data(), offsets.data());
+    }
+  };
   return partition;
 }
 

@@ -313,7 +313,7 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
     }
   }
   this->Rep.CloudDimension = dim;
-  this->ResolveAuto(globalValid, dim);
+  this->ResolveAuto(globalValid, dim, partition);
 
   // What else is global, over every part of a distributed cloud (collective, in this order on every part).
   if (partition)

@@ -147,6 +147,9 @@ struct CloudPartition
   std::function<void(double* values, int n)> Sum;
   std::function<void(double* values, int n)> Max;
   const unsigned char* Owned = nullptr;
+  /// Every part's `mine` appended in part order to `all`, the same on every part (an all-gather). Auto gathers
+  /// the few points of a small 2D cloud with it for its leave-one-out choice; null: Auto chooses by size alone.
+  std::function<void(const std::vector<double>& mine, std::vector<double>& all)> Gather;
 };
 
 /// What the evaluation at a set of points reads of the cloud (Approximator::Reach): the neighbourhoods of
@@ -304,7 +307,18 @@ private:
     const ApproximationOutput& out) const;
   /// RBF (ApproximationRBF.cxx): Auto's choice for the cloud (SetCloud), the duplicates' merge and the global
   /// fit or the RBF-PU patches that blend into the m points xyz; the evaluation at one point.
-  void ResolveAuto(Index globalValid, int dimension);
+  void ResolveAuto(Index globalValid, int dimension, const CloudPartition* partition);
+  /// Auto's estimate for a small 2D cloud (ApproximationRBF.cxx): the leave-one-out errors of the global
+  /// thin-plate spline and of PU-WLS over the valid points (every part's, gathered); false when either is not
+  /// defined (no component, a singular system, ...). errors[0]: spline, errors[1]: PU-WLS, each the rms over the
+  /// points of the residuals relative to the values' standard deviation, over the components.
+  bool AutoLeaveOneOut(const CloudPartition* partition, double errors[2]) const;
+  /// Leave-one-out residuals (f - the fit without that point) of every valid point (by id, n x C, NaN where
+  /// not defined) of this cloud (not distributed): the global polyharmonic spline (Rippa's formula, see
+  /// SolvePolyharmonic), PU-WLS (each patch's weighted fit without the point, from its hat matrix's diagonal:
+  /// r / (1 - h_jj); the patches and supports as the full cloud's).
+  bool LeaveOneOutRBF(std::vector<double>& residuals);
+  bool LeaveOneOutPU(std::vector<double>& residuals) const;
   bool RBFIsGlobal() const;
   int PatchSize() const;
   bool PrepareRBF(const double* xyz, Index m);
@@ -359,6 +373,7 @@ private:
   double GlobalCondition = 0.0;
   std::unique_ptr<PUData> PU;
   std::unique_ptr<RBFData> RBFFits;
+  bool RBFLeaveOneOut = false; // PrepareRBF also computes the global fit's leave-one-out residuals (Auto)
   ApproximationMethod Requested = ApproximationMethod::MLS; // Opts.Method before Auto was resolved
   std::unique_ptr<cuda::MLSDevice> Device; // the cloud on the CUDA device (uploaded on first use)
   bool DeviceUploaded = false;
