@@ -299,6 +299,21 @@ private:
   PointResult MLSPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult SPHPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult PUPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
+  /// One PU-WLS centre's fit at x (cover radius R): support SupportRadius, or max(SupportFactor d_k,
+  /// SupportFactor R), the fit over the points within it at Options.Degree, then at twice the support from
+  /// Options.Degree down to 0. Returns the degree used (coefficients, condition, the support h and the number m of
+  /// weighted points, which are s.Ids / s.Xi / s.Weights [0, m)), or -1: no fit, or no point within R (the centre
+  /// blends nothing).
+  int FitPUCentre(const double x[3], double R, FitScratch& s, double* coefficients, double& condition, double& h,
+    int& m) const;
+  /// The partition of unity at x, shared by PU-WLS and RBF-PU (ApproximationPU.h): the centres (positions xyz,
+  /// found in grid) within R weighted by theta(|x - x_c| / R), each centre's local fit given by
+  /// local(c, dx, values, gradients) - values (C) and, when gradients is not null, their gradients (D x C, per
+  /// unit length along the frame's axes) at dx = x - x_c -, blended by WriteBlend; info(c, result) fills
+  /// Neighbors, Condition and Lowered from the centre of largest weight.
+  template <class Local, class Info>
+  PointResult BlendCentres(const double x[3], const NeighborGrid& grid, const double* xyz, double R, FitScratch& s,
+    const ApproximationOutput& out, Index i, const Local& local, const Info& info) const;
   PointResult GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const;
   /// The partition of unity's last step (3.16-3.21), shared by PU-WLS and RBF-PU: the blended values
   /// sum(theta L) / sum(theta) and gradients of output point i from the sums (sumGrad and sumDTheta in the

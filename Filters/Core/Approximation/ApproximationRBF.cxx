@@ -510,7 +510,6 @@ bool Approximator::LeaveOneOutPU(std::vector<double>& residuals) const
 {
   const int D = this->Frame.Dimension;
   const int C = this->NumberOfComponents;
-  const int k = this->Opts.NeighborCount;
   const Index n = static_cast<Index>(this->Coordinates.size() / 3);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   residuals.assign(static_cast<size_t>(n) * C, nan);
@@ -533,32 +532,9 @@ bool Approximator::LeaveOneOutPU(std::vector<double>& residuals) const
   for (Index node = 0; node < nodes; ++node)
   {
     const double* x = &centers[3 * node];
-    double h = 0.0;
-    if (this->Opts.SupportRadius > 0.0)
-    {
-      h = this->Opts.SupportRadius;
-    }
-    else
-    {
-      this->Neighbors(x, k, 0.0, s, h);
-      h = std::max(h, this->Opts.SupportFactor * R);
-    }
-    int degree = -1, m = 0;
-    for (int attempt = 0; attempt < 2 && degree < 0; ++attempt, h *= 2.0)
-    {
-      this->Points.FindWithinRadius(x, h, s.Ids, &s.Dist2);
-      this->SortNeighbors(s, s.Ids.size());
-      const int count = static_cast<int>(s.Ids.size());
-      if (attempt == 0 &&
-        !std::any_of(s.Dist2.begin(), s.Dist2.end(), [&](double d2) { return d2 < R * R; }))
-      {
-        break;
-      }
-      s.Reserve(static_cast<size_t>(std::max(count, 1)));
-      m = this->GatherWeighted(x, count, h, s);
-      double condition = 0.0;
-      degree = this->FitDescending(attempt == 0 ? this->Opts.Degree : 0, s, m, coefficients.data(), condition);
-    }
+    double h = 0.0, condition = 0.0;
+    int m = 0;
+    const int degree = this->FitPUCentre(x, R, s, coefficients.data(), condition, h, m);
     if (degree < 0)
     {
       continue;
@@ -902,24 +878,22 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
 Approximator::PointResult Approximator::RBFPoint(
   const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const
 {
-  PointResult result{ false, 0, 0.0, false, false };
   const RBFData& rbf = *this->RBFFits;
   const int D = this->Frame.Dimension;
   const int C = this->NumberOfComponents;
-  const bool gradient = out.Gradients != nullptr;
   const size_t tailStride = static_cast<size_t>(kMaxBasisSize) * C;
-  // Work: blended values (C), blended local gradients (3C), one fit's values (C) and gradients (3C).
-  if (s.Work.size() < 8 * static_cast<size_t>(C) + 8)
-  {
-    s.Work.resize(8 * static_cast<size_t>(C) + 8);
-  }
-  double* sumValues = s.Work.data();
-  double* sumGrad = sumValues + C;
-  double* local = sumGrad + 3 * C;
-  double* localGrad = local + C;
-  bool finite = true;
   if (rbf.Global)
   {
+    PointResult result{ false, 0, 0.0, false, false };
+    const bool gradient = out.Gradients != nullptr;
+    // Work: the fit's values (C) and gradients (3C).
+    if (s.Work.size() < 4 * static_cast<size_t>(C) + 4)
+    {
+      s.Work.resize(4 * static_cast<size_t>(C) + 4);
+    }
+    double* local = s.Work.data();
+    double* localGrad = local + C;
+    bool finite = true;
     const PolyharmonicFit& fit = rbf.Fits[0];
     const double dx[3] = { x[0] - fit.Origin[0], x[1] - fit.Origin[1], x[2] - fit.Origin[2] };
     double xi[3] = { 0, 0, 0 };
@@ -957,69 +931,28 @@ Approximator::PointResult Approximator::RBFPoint(
   }
 
   // RBF-PU: the fits whose node lies within R, blended as PU-WLS blends its fits (3.16-3.21).
-  const double R = rbf.CoverRadius;
-  rbf.CenterGrid.FindWithinRadius(x, R, s.Ids, &s.Dist2);
-  SortById(s, s.Ids.size());
-  std::fill(sumValues, sumValues + 4 * C, 0.0);
-  double sumTheta = 0.0;
-  double sumDTheta[3] = { 0, 0, 0 };
-  double best = 0.0;
-  for (size_t j = 0; j < s.Ids.size(); ++j)
-  {
-    const double theta = this->UnitKernel.ValueSquared(s.Dist2[j] / (R * R));
-    if (!(theta > 0.0))
-    {
-      continue;
-    }
-    const Index c = s.Ids[j];
+  auto fitAt = [&](Index c, const double dx[3], double* values, double* gradients) {
     const PolyharmonicFit& fit = rbf.Fits[c];
-    const double dx[3] = { x[0] - fit.Origin[0], x[1] - fit.Origin[1], x[2] - fit.Origin[2] };
     double xi[3] = { 0, 0, 0 };
     this->Frame.Project<3>(dx, fit.InvScale, xi);
     for (int a = D; a < 3; ++a)
     {
       xi[a] = 0.0;
     }
-    EvaluatePolyharmonic(D, rbf.Beta, fit, rbf.X.data(), rbf.W.data(), &rbf.Tail[tailStride * c], xi, C, local,
-      gradient ? localGrad : nullptr);
-    sumTheta += theta;
-    for (int q = 0; q < C; ++q)
+    EvaluatePolyharmonic(
+      D, rbf.Beta, fit, rbf.X.data(), rbf.W.data(), &rbf.Tail[tailStride * c], xi, C, values, gradients);
+    for (int a = 0; gradients && a < D * C; ++a)
     {
-      sumValues[q] += theta * local[q];
+      gradients[a] *= fit.InvScale; // per unit xi -> per unit length
     }
-    if (gradient)
-    {
-      double r[3] = { 0, 0, 0 }, dTheta[3];
-      this->Frame.Project<3>(dx, 1.0 / R, r);
-      for (int a = D; a < 3; ++a)
-      {
-        r[a] = 0.0;
-      }
-      this->UnitKernel.Gradient(r, dTheta); // per unit r / R
-      for (int a = 0; a < D; ++a)
-      {
-        dTheta[a] /= R;
-        sumDTheta[a] += dTheta[a];
-        for (int q = 0; q < C; ++q)
-        {
-          sumGrad[a * C + q] += dTheta[a] * local[q] + theta * localGrad[a * C + q] * fit.InvScale;
-        }
-      }
-    }
-    if (theta > best)
-    {
-      best = theta;
-      result.Neighbors = static_cast<int>(fit.Count);
-      result.Condition = fit.Condition;
-      result.Lowered = fit.Degree < this->Opts.TailDegree;
-    }
-  }
-  if (!(sumTheta > 0.0))
-  {
-    return result;
-  }
-  result.Valid = this->WriteBlend(i, sumValues, sumGrad, sumDTheta, sumTheta, out);
-  return result;
+  };
+  auto info = [&](Index c, PointResult& r) {
+    const PolyharmonicFit& fit = rbf.Fits[c];
+    r.Neighbors = static_cast<int>(fit.Count);
+    r.Condition = fit.Condition;
+    r.Lowered = fit.Degree < this->Opts.TailDegree;
+  };
+  return this->BlendCentres(x, rbf.CenterGrid, rbf.Centers.data(), rbf.CoverRadius, s, out, i, fitAt, info);
 }
 
 } // namespace meshfree
