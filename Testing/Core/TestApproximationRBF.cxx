@@ -90,6 +90,7 @@ struct Reproduction
   Index GlobalLimit; // 0: RBF-PU
   double Offset;
   double Scale;
+  RBFKernelType Kernel = RBFKernelType::Polyharmonic;
 };
 
 class RBFReproduction : public ::testing::TestWithParam<Reproduction>
@@ -126,6 +127,7 @@ TEST_P(RBFReproduction, TailAndDataExactly)
   }
   ApproximationOptions opts = RBFOptions(c.GlobalLimit);
   opts.TailDegree = c.Tail;
+  opts.RBFKernel = c.Kernel;
   Approximator approx;
   ASSERT_TRUE(approx.SetOptions(opts)) << approx.Error();
   ASSERT_TRUE(approx.SetCloud(xyz.data(), n, values.data(), 2));
@@ -169,7 +171,61 @@ INSTANTIATE_TEST_SUITE_P(Clouds, RBFReproduction,
   ::testing::Values(Reproduction{ 2, 1, 2000, 0.0, 1.0 }, Reproduction{ 2, 2, 2000, 0.0, 1.0 },
     Reproduction{ 2, 1, 2000, 1e6, 1.0 }, Reproduction{ 2, 1, 2000, 0.0, 1e-6 }, Reproduction{ 2, 1, 2000, 0.0, 1e6 },
     Reproduction{ 3, 1, 2000, 0.0, 1.0 }, Reproduction{ 3, 1, 2000, 1e6, 1.0 }, Reproduction{ 2, 1, 0, 0.0, 1.0 },
-    Reproduction{ 2, 1, 0, 1e6, 1.0 }, Reproduction{ 2, 1, 0, 0.0, 1e-6 }, Reproduction{ 3, 1, 0, 0.0, 1.0 }));
+    Reproduction{ 2, 1, 0, 1e6, 1.0 }, Reproduction{ 2, 1, 0, 0.0, 1e-6 }, Reproduction{ 3, 1, 0, 0.0, 1.0 },
+    // Wendland's C2 kernel: its linear tail and the data reproduced the same way.
+    Reproduction{ 2, 1, 2000, 0.0, 1.0, RBFKernelType::WendlandC2 },
+    Reproduction{ 2, 1, 2000, 1e6, 1.0, RBFKernelType::WendlandC2 },
+    Reproduction{ 2, 1, 2000, 0.0, 1e-6, RBFKernelType::WendlandC2 },
+    Reproduction{ 3, 1, 2000, 0.0, 1.0, RBFKernelType::WendlandC2 },
+    Reproduction{ 2, 1, 0, 0.0, 1.0, RBFKernelType::WendlandC2 },
+    Reproduction{ 3, 1, 0, 0.0, 1.0, RBFKernelType::WendlandC2 }));
+
+TEST(RBF, WendlandKernelIsCompactlySupportedAndItsSlopeIsItsDerivative)
+{
+  EXPECT_EQ(PolyharmonicValue(kWendlandBeta, 0.0), 1.0);
+  EXPECT_EQ(PolyharmonicValue(kWendlandBeta, 1.0), 0.0);
+  EXPECT_EQ(PolyharmonicValue(kWendlandBeta, 4.0), 0.0);
+  EXPECT_EQ(PolyharmonicSlope(kWendlandBeta, 1.5), 0.0);
+  for (double r : { 0.1, 0.35, 0.6, 0.9 })
+  {
+    const double e = 1e-6;
+    const double derivative =
+      (PolyharmonicValue(kWendlandBeta, (r + e) * (r + e)) - PolyharmonicValue(kWendlandBeta, (r - e) * (r - e))) /
+      (2 * e);
+    EXPECT_NEAR(PolyharmonicSlope(kWendlandBeta, r * r) * r, derivative, 1e-8) << r;
+    EXPECT_GT(PolyharmonicValue(kWendlandBeta, r * r), 0.0);
+  }
+  // A fixed SupportRadius is the kernel's support: a global fit with rho = 0.05 on 300 points (about 2 in each
+  // support) and with rho = 0.5 both interpolate, and differ away from the data.
+  const int n = 300;
+  const std::vector<double> xyz = Cloud(n, 2);
+  std::vector<double> values(n);
+  for (int i = 0; i < n; ++i)
+    values[i] = Franke(xyz[3 * i], xyz[3 * i + 1]);
+  const std::vector<double> eval = Cloud(100, 2, 0.1, 0.8, 5000);
+  std::vector<double> at[2];
+  int k = 0;
+  for (double rho : { 0.05, 0.5 })
+  {
+    ApproximationOptions opts = RBFOptions();
+    opts.RBFKernel = RBFKernelType::WendlandC2;
+    opts.SupportRadius = rho;
+    Approximator approx;
+    ASSERT_TRUE(approx.SetOptions(opts));
+    ASSERT_TRUE(approx.SetCloud(xyz.data(), n, values.data(), 1));
+    std::vector<double> both = eval;
+    both.insert(both.end(), xyz.begin(), xyz.end());
+    const Result r = EvaluateAll(approx, both);
+    ExpectFinite(r);
+    for (int i = 0; i < n; ++i)
+      EXPECT_NEAR(r.Values[100 + i], values[i], 1e-10);
+    at[k++].assign(r.Values.begin(), r.Values.begin() + 100);
+  }
+  double differ = 0.0;
+  for (int i = 0; i < 100; ++i)
+    differ = std::max(differ, std::fabs(at[0][i] - at[1][i]));
+  EXPECT_GT(differ, 1e-4);
+}
 
 // ---------------------------------------------------------------------------------------------- convergence
 double RBFPUError(int n)

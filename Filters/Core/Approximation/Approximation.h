@@ -100,6 +100,13 @@ enum class ApproximationBackend
 /// measured on a GPU.
 constexpr double kAutoDeviceWork = 1e6;
 
+/// Method RBF's kernel (ApproximationOptions::RBFKernel).
+enum class RBFKernelType
+{
+  Polyharmonic = 0,
+  WendlandC2 = 1
+};
+
 struct ApproximationOptions
 {
   ApproximationMethod Method = ApproximationMethod::MLS;
@@ -123,6 +130,11 @@ struct ApproximationOptions
   int TailDegree = 1;
   Index RBFGlobalLimit = 1000;
   int PatchPoints = 0;
+  // The RBF kernel: polyharmonic (no shape parameter) or Wendland's C2 function (1 - r/rho)^4 (4 r/rho + 1),
+  // compactly supported, positive definite in 1 to 3 dimensions; rho = SupportRadius when set, else
+  // SupportFactor x the RBF-PU cover radius (a ball holding about PatchPoints points) for the global fit, and
+  // each RBF-PU patch's support radius for its fit.
+  RBFKernelType RBFKernel = RBFKernelType::Polyharmonic;
 };
 
 /// Where the results go (m evaluation points, C components). Null pointers switch outputs off.

@@ -74,7 +74,7 @@ bool SolvePolyharmonic(int D, int beta, int degree, double lambda, const double*
   for (Index i = 0; i < n; ++i)
   {
     const double* a = xi + 3 * i;
-    B(i, i) = lambda;
+    B(i, i) = lambda + PolyharmonicValue(beta, 0.0); // phi(0): 0 for the polyharmonic kernels, 1 for Wendland's
     for (Index j = 0; j < i; ++j)
     {
       const double* b = xi + 3 * j;
@@ -208,7 +208,7 @@ void EvaluatePolyharmonic(int D, int beta, const PolyharmonicFit& fit, const dou
   {
     // The common case (one scalar field): a tight loop.
     double sum = 0.0;
-    if (D == 2)
+    if (D == 2 && beta == 2)
     {
       for (Index j = 0; j < n; ++j)
       {
@@ -295,6 +295,7 @@ void Approximator::ResolveAuto(Index globalValid, int dimension, const CloudPart
     // smoothing (noisy data): the smoothing spline up to RBFGlobalLimit, a moving least-squares fit (which does
     // not interpolate) above.
     const bool smoothing = this->Opts.Smoothing > 0.0;
+    this->Opts.RBFKernel = RBFKernelType::Polyharmonic; // the kernel measured
     const Index small2D = std::min<Index>(kAutoRBFPoints2D, this->Opts.RBFGlobalLimit);
     const int puDegree = std::max(this->Opts.Degree, 3);
     if (dimension == 0)
@@ -427,6 +428,7 @@ bool Approximator::AutoLeaveOneOut(const CloudPartition* partition, double error
   options.Diagnostics = false;
   options.ComputeGradients = false;
   options.Smoothing = 0.0;
+  options.RBFKernel = RBFKernelType::Polyharmonic;
   options.RBFGlobalLimit = std::max<Index>(n, 1);
   Approximator trial;
   std::vector<double> splineLOO, puLOO;
@@ -598,10 +600,11 @@ bool Approximator::LeaveOneOutPU(std::vector<double>& residuals) const
 
 namespace
 {
-/// The kernel's exponent beta in the cloud's intrinsic dimension: r^2 log r in 2D, r^3 otherwise.
-int KernelBeta(int dimension)
+/// The kernel's exponent beta in the cloud's intrinsic dimension: r^2 log r in 2D, r^3 otherwise (kWendlandBeta
+/// for Wendland's C2 kernel).
+int KernelBeta(int dimension, RBFKernelType kernel)
 {
-  return dimension == 2 ? 2 : 3;
+  return kernel == RBFKernelType::WendlandC2 ? kWendlandBeta : (dimension == 2 ? 2 : 3);
 }
 } // namespace
 
@@ -635,7 +638,8 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
   const int C = this->NumberOfComponents;
   const Index n = static_cast<Index>(this->Coordinates.size() / 3);
   const double* coords = this->Coordinates.data();
-  rbf.Beta = KernelBeta(D);
+  rbf.Beta = KernelBeta(D, this->Opts.RBFKernel);
+  const bool wendland = rbf.Beta == kWendlandBeta;
   rbf.Global = this->RBFIsGlobal();
   this->Rep.MergedPoints = 0;
   this->Rep.Regularized = 0;
@@ -729,7 +733,17 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
       }
       largest2 = std::max(largest2, r2);
     }
-    const double scale = largest2 > 0.0 && std::isfinite(largest2) ? std::sqrt(largest2) : 1.0;
+    double scale = largest2 > 0.0 && std::isfinite(largest2) ? std::sqrt(largest2) : 1.0;
+    if (wendland)
+    {
+      // Coordinates in units of the support radius rho: SupportRadius, else SupportFactor x the cover radius
+      // of the RBF-PU lattice (a ball holding about PatchPoints points).
+      double umin[3], spacing = 1.0, cover = 1.0;
+      Index counts[3];
+      this->PULattice(umin, spacing, cover, counts);
+      const double rho = this->Opts.SupportRadius > 0.0 ? this->Opts.SupportRadius : this->Opts.SupportFactor * cover;
+      scale = rho > 0.0 && std::isfinite(rho) ? rho : scale;
+    }
     PolyharmonicFit fit;
     std::copy(centre, centre + 3, fit.Origin);
     fit.InvScale = 1.0 / scale;

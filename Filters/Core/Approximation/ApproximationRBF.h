@@ -72,7 +72,7 @@ struct PolyharmonicFit
 struct Approximator::RBFData
 {
   bool Global = true;
-  int Beta = 2;                     // 2: r^2 log r, 3: r^3
+  int Beta = 2;                     // 2: r^2 log r, 3: r^3, kWendlandBeta: Wendland's C2
   std::vector<double> X;            // 3 per centre: its local coordinates in its fit's frame
   std::vector<double> W;            // C per centre
   std::vector<double> Tail;         // kMaxBasisSize * C per fit (row-major, PolynomialBasis order)
@@ -128,17 +128,36 @@ inline double KernelLog(double x)
   return e * 0.69314718055994530942 + 2.0 * s * p;
 }
 
-/// phi(r) from r^2 for beta = 2 (r^2 log r = r^2 log(r^2) / 2) and 3 (r^3); 0 at r = 0.
+/// RBFData::Beta of Wendland's C2 kernel (RBFKernelType::WendlandC2): phi(r) = (1 - r)^4 (4 r + 1) for r < 1,
+/// 0 beyond, in coordinates scaled by the support radius (the fit's InvScale is 1 / rho). Being positive
+/// definite, its systems need no scaling of the smoothing (beta 0: lambda' = lambda).
+constexpr int kWendlandBeta = 0;
+
+/// phi(r) from r^2 for beta = 2 (r^2 log r = r^2 log(r^2) / 2), 3 (r^3) and kWendlandBeta; r^2 log r and r^3
+/// are 0 at r = 0.
 inline double PolyharmonicValue(int beta, double r2)
 {
+  if (beta == kWendlandBeta)
+  {
+    const double r = std::sqrt(r2);
+    const double t = r < 1.0 ? 1.0 - r : 0.0;
+    return t * t * t * t * (4.0 * r + 1.0);
+  }
   const double r2safe = r2 > 1e-300 ? r2 : 1.0; // log(1) = 0: phi(0) = 0 (and subnormal r^2 counts as 0)
   return beta == 2 ? 0.5 * r2 * KernelLog(r2safe) : r2 * std::sqrt(r2);
 }
 
-/// phi'(r) / r (the gradient is this times xi - xi_j): log(r^2) + 1 for beta = 2, 3 r for beta = 3; 0 at r = 0
-/// (where xi - xi_j = 0).
+/// phi'(r) / r (the gradient is this times xi - xi_j): log(r^2) + 1 for beta = 2, 3 r for beta = 3,
+/// -20 (1 - r)^3 for Wendland's C2 (0 beyond r = 1); 0 at r = 0 for the polyharmonic kernels (where
+/// xi - xi_j = 0).
 inline double PolyharmonicSlope(int beta, double r2)
 {
+  if (beta == kWendlandBeta)
+  {
+    const double r = std::sqrt(r2);
+    const double t = r < 1.0 ? 1.0 - r : 0.0;
+    return -20.0 * t * t * t;
+  }
   if (!(r2 > 1e-300))
   {
     return 0.0;
