@@ -90,12 +90,14 @@ for dim, n in ((2, 150), (3, 250)):
         assert "RBFGlobalLimit" in field_string(out, "ApproximationMethodReason")
         simple.Delete(approx)
 
-    # Through the data (the cloud as probe): global and RBF-PU both interpolate.
-    for limit, name in ((1000, "RBF (global)"), (0, "RBF-PU")):
-        approx = MeshlessApproximation(Input=cloud, Probe=cloud, Method="RBF", RBFGlobalLimit=limit)
+    # Through the data (the cloud as probe): global and RBF-PU both interpolate, with either kernel.
+    for (limit, name), kernel in [(c, k) for k in ("Polyharmonic", "Wendland C2")
+                                  for c in ((1000, "RBF (global)"), (0, "RBF-PU"))]:
+        approx = MeshlessApproximation(Input=cloud, Probe=cloud, Method="RBF", RBFGlobalLimit=limit,
+                                       RBFKernel=kernel)
         out = meshfree_test.fetch(approx)
         err = np.abs(np.asarray(out.PointData["f"]) - f).max()
-        print("%dD %s through the data: max error %.3g" % (dim, name, err))
+        print("%dD %s (%s) through the data: max error %.3g" % (dim, name, kernel, err))
         assert err <= 1e-10 * np.ptp(f), (name, err)
         assert field_string(out, "ApproximationMethod") == name
         simple.Delete(approx)
