@@ -335,7 +335,7 @@ bool AgreeOnSelection(vtkMultiProcessController* controller, vtkIdType n, vtkPoi
   return n == 0;
 }
 
-/// Collective: Sum and Max over the controller's ranks for the core's distributed cloud.
+/// Collective: Sum, Max and Gather over the controller's ranks for the core's distributed cloud.
 meshfree::CloudPartition Partition(vtkMultiProcessController* controller, const unsigned char* owned)
 {
   meshfree::CloudPartition partition;
@@ -347,6 +347,24 @@ meshfree::CloudPartition Partition(vtkMultiProcessController* controller, const 
   partition.Sum = [reduce](double* values, int n) { reduce(values, n, vtkCommunicator::SUM_OP); };
   partition.Max = [reduce](double* values, int n) { reduce(values, n, vtkCommunicator::MAX_OP); };
   partition.Owned = owned;
+  partition.Gather = [controller](const std::vector<double>& mine, std::vector<double>& all) {
+    const int parts = controller->GetNumberOfProcesses();
+    const vtkIdType length = static_cast<vtkIdType>(mine.size());
+    std::vector<vtkIdType> lengths(static_cast<size_t>(parts), 0), offsets(static_cast<size_t>(parts), 0);
+    controller->AllGather(&length, lengths.data(), 1);
+    vtkIdType total = 0;
+    for (int p = 0; p < parts; ++p)
+    {
+      offsets[p] = total;
+      total += lengths[p];
+    }
+    all.assign(static_cast<size_t>(total), 0.0);
+    if (total > 0)
+    {
+      double none = 0.0;
+      controller->AllGatherV(mine.empty() ? &none : mine.data(), all.data(), length, lengths.data(), offsets.data());
+    }
+  };
   return partition;
 }
 
@@ -518,6 +536,7 @@ int vtkMeshlessApproximation::RequestData(
   opts.Backend = static_cast<meshfree::ApproximationBackend>(this->Backend);
   opts.Smoothing = this->Smoothing;
   opts.RBFGlobalLimit = this->RBFGlobalLimit;
+  opts.RBFKernel = static_cast<meshfree::RBFKernelType>(this->RBFKernel);
   if (!std::isfinite(this->NullValue))
   {
     vtkWarningMacro("NullValue " << this->NullValue << " is not a finite number: masked points get 0 instead.");
@@ -921,6 +940,7 @@ void vtkMeshlessApproximation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NullValue: " << this->NullValue << "\n";
   os << indent << "Smoothing: " << this->Smoothing << "\n";
   os << indent << "RBFGlobalLimit: " << this->RBFGlobalLimit << "\n";
+  os << indent << "RBFKernel: " << this->RBFKernel << "\n";
   os << indent << "Backend: " << this->Backend << "\n";
   os << indent << "ModelBounds: " << this->ModelBounds[0] << ", " << this->ModelBounds[1] << ", "
      << this->ModelBounds[2] << ", " << this->ModelBounds[3] << ", " << this->ModelBounds[4] << ", "

@@ -18,7 +18,8 @@
  * in 1D and 3D - with a linear polynomial tail, SciPy's RBFInterpolator defaults; one global fit up to
  * RBFGlobalLimit valid points, above it a partition of unity of local RBF fits on the PU-WLS lattice, RBF-PU;
  * Smoothing > 0 makes it a smoothing spline, with SciPy's `smoothing` meaning), Auto (a measured choice: 2D
- * clouds up to 200 points the global thin-plate spline, larger ones PU-WLS of degree 3; 1D and 3D clouds RBF;
+ * clouds up to 150 points the global thin-plate spline or PU-WLS of degree 3 by their leave-one-out errors, larger
+ * ones PU-WLS of degree 3; 1D and 3D clouds RBF;
  * with Smoothing > 0 the smoothing spline up to RBFGlobalLimit points, MLS above; see ResolveAuto in
  * Filters/Core/Approximation/ApproximationRBF.cxx). BasisDegree 0-3
  * in the cloud's own dimension (not used by RBF, whose tail is linear). WeightFunction: a meshfree::KernelType
@@ -161,6 +162,19 @@ public:
   ///@}
 
   ///@{
+  /// RBF: the kernel, RBF_POLYHARMONIC (default: thin-plate spline in 2D, r^3 in 1D/3D) or RBF_WENDLAND_C2
+  /// (compactly supported, support SupportRadius or SupportFactor x the RBF-PU cover radius; see
+  /// meshfree::ApproximationOptions::RBFKernel). Auto uses the polyharmonic kernel.
+  enum RBFKernels
+  {
+    RBF_POLYHARMONIC = 0,
+    RBF_WENDLAND_C2 = 1
+  };
+  vtkSetClampMacro(RBFKernel, int, RBF_POLYHARMONIC, RBF_WENDLAND_C2);
+  vtkGetMacro(RBFKernel, int);
+  ///@}
+
+  ///@{
   /// Value written where a point cannot be evaluated (default 0).
   vtkSetMacro(NullValue, double);
   vtkGetMacro(NullValue, double);
@@ -238,6 +252,7 @@ protected:
   double NullValue = 0.0;
   double Smoothing = 0.0;
   int RBFGlobalLimit = 1000;
+  int RBFKernel = RBF_POLYHARMONIC;
   int Backend = BACKEND_AUTO;
   double ModelBounds[6] = { 0, 0, 0, 0, 0, 0 };
   int SampleDimensions[3] = { 101, 101, 101 };

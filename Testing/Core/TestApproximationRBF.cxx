@@ -6,11 +6,13 @@
 // defined, finite result; the result does not depend on the points' order; Auto says what it chose.
 #include "TestFunctions.h"
 #include "Approximation/Approximation.h"
+#include "Approximation/ApproximationRBF.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <numeric>
@@ -88,6 +90,7 @@ struct Reproduction
   Index GlobalLimit; // 0: RBF-PU
   double Offset;
   double Scale;
+  RBFKernelType Kernel = RBFKernelType::Polyharmonic;
 };
 
 class RBFReproduction : public ::testing::TestWithParam<Reproduction>
@@ -124,6 +127,7 @@ TEST_P(RBFReproduction, TailAndDataExactly)
   }
   ApproximationOptions opts = RBFOptions(c.GlobalLimit);
   opts.TailDegree = c.Tail;
+  opts.RBFKernel = c.Kernel;
   Approximator approx;
   ASSERT_TRUE(approx.SetOptions(opts)) << approx.Error();
   ASSERT_TRUE(approx.SetCloud(xyz.data(), n, values.data(), 2));
@@ -167,7 +171,61 @@ INSTANTIATE_TEST_SUITE_P(Clouds, RBFReproduction,
   ::testing::Values(Reproduction{ 2, 1, 2000, 0.0, 1.0 }, Reproduction{ 2, 2, 2000, 0.0, 1.0 },
     Reproduction{ 2, 1, 2000, 1e6, 1.0 }, Reproduction{ 2, 1, 2000, 0.0, 1e-6 }, Reproduction{ 2, 1, 2000, 0.0, 1e6 },
     Reproduction{ 3, 1, 2000, 0.0, 1.0 }, Reproduction{ 3, 1, 2000, 1e6, 1.0 }, Reproduction{ 2, 1, 0, 0.0, 1.0 },
-    Reproduction{ 2, 1, 0, 1e6, 1.0 }, Reproduction{ 2, 1, 0, 0.0, 1e-6 }, Reproduction{ 3, 1, 0, 0.0, 1.0 }));
+    Reproduction{ 2, 1, 0, 1e6, 1.0 }, Reproduction{ 2, 1, 0, 0.0, 1e-6 }, Reproduction{ 3, 1, 0, 0.0, 1.0 },
+    // Wendland's C2 kernel: its linear tail and the data reproduced the same way.
+    Reproduction{ 2, 1, 2000, 0.0, 1.0, RBFKernelType::WendlandC2 },
+    Reproduction{ 2, 1, 2000, 1e6, 1.0, RBFKernelType::WendlandC2 },
+    Reproduction{ 2, 1, 2000, 0.0, 1e-6, RBFKernelType::WendlandC2 },
+    Reproduction{ 3, 1, 2000, 0.0, 1.0, RBFKernelType::WendlandC2 },
+    Reproduction{ 2, 1, 0, 0.0, 1.0, RBFKernelType::WendlandC2 },
+    Reproduction{ 3, 1, 0, 0.0, 1.0, RBFKernelType::WendlandC2 }));
+
+TEST(RBF, WendlandKernelIsCompactlySupportedAndItsSlopeIsItsDerivative)
+{
+  EXPECT_EQ(PolyharmonicValue(kWendlandBeta, 0.0), 1.0);
+  EXPECT_EQ(PolyharmonicValue(kWendlandBeta, 1.0), 0.0);
+  EXPECT_EQ(PolyharmonicValue(kWendlandBeta, 4.0), 0.0);
+  EXPECT_EQ(PolyharmonicSlope(kWendlandBeta, 1.5), 0.0);
+  for (double r : { 0.1, 0.35, 0.6, 0.9 })
+  {
+    const double e = 1e-6;
+    const double derivative =
+      (PolyharmonicValue(kWendlandBeta, (r + e) * (r + e)) - PolyharmonicValue(kWendlandBeta, (r - e) * (r - e))) /
+      (2 * e);
+    EXPECT_NEAR(PolyharmonicSlope(kWendlandBeta, r * r) * r, derivative, 1e-8) << r;
+    EXPECT_GT(PolyharmonicValue(kWendlandBeta, r * r), 0.0);
+  }
+  // A fixed SupportRadius is the kernel's support: a global fit with rho = 0.05 on 300 points (about 2 in each
+  // support) and with rho = 0.5 both interpolate, and differ away from the data.
+  const int n = 300;
+  const std::vector<double> xyz = Cloud(n, 2);
+  std::vector<double> values(n);
+  for (int i = 0; i < n; ++i)
+    values[i] = Franke(xyz[3 * i], xyz[3 * i + 1]);
+  const std::vector<double> eval = Cloud(100, 2, 0.1, 0.8, 5000);
+  std::vector<double> at[2];
+  int k = 0;
+  for (double rho : { 0.05, 0.5 })
+  {
+    ApproximationOptions opts = RBFOptions();
+    opts.RBFKernel = RBFKernelType::WendlandC2;
+    opts.SupportRadius = rho;
+    Approximator approx;
+    ASSERT_TRUE(approx.SetOptions(opts));
+    ASSERT_TRUE(approx.SetCloud(xyz.data(), n, values.data(), 1));
+    std::vector<double> both = eval;
+    both.insert(both.end(), xyz.begin(), xyz.end());
+    const Result r = EvaluateAll(approx, both);
+    ExpectFinite(r);
+    for (int i = 0; i < n; ++i)
+      EXPECT_NEAR(r.Values[100 + i], values[i], 1e-10);
+    at[k++].assign(r.Values.begin(), r.Values.begin() + 100);
+  }
+  double differ = 0.0;
+  for (int i = 0; i < 100; ++i)
+    differ = std::max(differ, std::fabs(at[0][i] - at[1][i]));
+  EXPECT_GT(differ, 1e-4);
+}
 
 // ---------------------------------------------------------------------------------------------- convergence
 double RBFPUError(int n)
@@ -492,8 +550,9 @@ TEST(RBF, IndependentOfThePointsOrder)
 
 TEST(RBF, AutoSaysWhatItChoseAndWhy)
 {
-  // 2D: the thin-plate spline for small clouds, PU-WLS of degree 3 above kAutoRBFPoints2D (200); 3D: r^3, global
-  // up to RBFGlobalLimit, RBF-PU above.
+  // 2D: PU-WLS of degree 3 above kAutoRBFPoints2D (150), below it the spline or PU-WLS by their leave-one-out
+  // errors (on Franke's function at 100 points: the spline, 0.033 vs 0.044 of the values' spread); 3D: r^3,
+  // global up to RBFGlobalLimit, RBF-PU above.
   const struct
   {
     int N, Dim;
@@ -524,6 +583,131 @@ TEST(RBF, AutoSaysWhatItChoseAndWhy)
   EXPECT_EQ(m, ApproximationMethod::RBF);
   ASSERT_TRUE(ApproximationMethodFromName("Auto", m));
   EXPECT_EQ(m, ApproximationMethod::Auto);
+}
+
+TEST(RBF, LeaveOneOutResidualsAreThoseOfTheRefits)
+{
+  // Rippa's formula (SolvePolyharmonic's leaveOneOut) against solving the system again without each centre:
+  // f_j - s_(j)(x_j), 2D thin-plate and 3D r^3, two components.
+  for (int dim : { 2, 3 })
+  {
+    const int n = 40, C = 2;
+    const std::vector<double> xyz = Cloud(n, dim);
+    std::vector<double> f(static_cast<size_t>(n) * C);
+    for (int i = 0; i < n; ++i)
+    {
+      f[C * i] = Franke(xyz[3 * i], xyz[3 * i + 1]) + (dim == 3 ? xyz[3 * i + 2] * xyz[3 * i + 2] : 0.0);
+      f[C * i + 1] = std::sin(4.0 * xyz[3 * i]) * std::cos(3.0 * xyz[3 * i + 1]);
+    }
+    const int beta = dim == 2 ? 2 : 3;
+    std::vector<double> w(static_cast<size_t>(n) * C), tail(static_cast<size_t>(kMaxBasisSize) * C),
+      loo(static_cast<size_t>(n) * C);
+    PolyharmonicFit fit;
+    ASSERT_TRUE(SolvePolyharmonic(dim, beta, 1, 0.0, xyz.data(), n, f.data(), C, w.data(), tail.data(), fit, loo.data()));
+    double largest = 0.0;
+    for (int j = 0; j < n; ++j)
+    {
+      std::vector<double> x2, f2;
+      for (int i = 0; i < n; ++i)
+      {
+        if (i != j)
+        {
+          x2.insert(x2.end(), &xyz[3 * i], &xyz[3 * i] + 3);
+          f2.insert(f2.end(), &f[C * i], &f[C * i] + C);
+        }
+      }
+      std::vector<double> w2(static_cast<size_t>(n - 1) * C), tail2(tail.size());
+      PolyharmonicFit fit2;
+      ASSERT_TRUE(SolvePolyharmonic(dim, beta, 1, 0.0, x2.data(), n - 1, f2.data(), C, w2.data(), tail2.data(), fit2));
+      fit2.Offset = 0;
+      fit2.Count = n - 1;
+      double out[2];
+      EvaluatePolyharmonic(dim, beta, fit2, x2.data(), w2.data(), tail2.data(), &xyz[3 * j], C, out, nullptr);
+      for (int c = 0; c < C; ++c)
+      {
+        const double refit = f[C * j + c] - out[c];
+        EXPECT_NEAR(loo[C * j + c], refit, 1e-8 * (1.0 + std::fabs(refit))) << "dim " << dim << " point " << j;
+        largest = std::max(largest, std::fabs(refit));
+      }
+    }
+    EXPECT_GT(largest, 1e-4); // the residuals are not trivially zero
+    // With smoothing the formula does not hold: no residuals (NaN), the fit itself still succeeds.
+    ASSERT_TRUE(SolvePolyharmonic(dim, beta, 1, 1e-3, xyz.data(), n, f.data(), C, w.data(), tail.data(), fit, loo.data()));
+    for (double v : loo)
+      EXPECT_TRUE(std::isnan(v));
+  }
+}
+
+TEST(RBF, AutoLeaveOneOutPicksTheMoreAccurate)
+{
+  // Small 2D clouds: a cubic polynomial, which PU-WLS of degree 3 reproduces (its leave-one-out error vanishes)
+  // and the thin-plate spline does not -> PU-WLS; a thin-plate spline with four of the data points as centres
+  // (weights orthogonal to the linear polynomials) plus a plane, which the spline reproduces whenever those
+  // points are kept (only their own four residuals are not zero) and PU-WLS does not (the kernel's second
+  // derivatives are singular at the centres) -> the spline. Both with the estimate's figures in the reason; a
+  // second, constant component changes nothing (it is left out of the estimate).
+  const int n = 120;
+  const std::vector<double> xyz = Cloud(n, 2);
+  const int centres[4] = { 17, 37, 58, 91 };
+  double weights[4];
+  for (int k = 0; k < 4; ++k)
+  {
+    // The null vector of [1; x; y] over the four centres: w_k = (-1)^k det(the 3 x 3 minor without column k).
+    double m[3][3];
+    for (int c = 0, col = 0; c < 4; ++c)
+    {
+      if (c == k)
+        continue;
+      m[0][col] = 1.0;
+      m[1][col] = xyz[3 * centres[c]];
+      m[2][col] = xyz[3 * centres[c] + 1];
+      ++col;
+    }
+    const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+      m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    weights[k] = (k % 2 == 0 ? 1.0 : -1.0) * det;
+  }
+  for (int which = 0; which < 2; ++which)
+  {
+    std::vector<double> values(2 * static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i)
+    {
+      const double x = xyz[3 * i], y = xyz[3 * i + 1];
+      double spline = 0.3 * x - 0.2 * y;
+      for (int k = 0; k < 4; ++k)
+      {
+        const double* p = &xyz[3 * centres[k]];
+        const double r2 = (x - p[0]) * (x - p[0]) + (y - p[1]) * (y - p[1]);
+        spline += weights[k] * (r2 > 0.0 ? 0.5 * r2 * std::log(r2) : 0.0);
+      }
+      values[2 * i] = which == 0 ? 0.2 + x - 0.5 * y + 0.8 * x * x * y - 0.3 * y * y * y + 0.4 * x * y : spline;
+      values[2 * i + 1] = 2.5;
+    }
+    ApproximationOptions opts;
+    opts.Method = ApproximationMethod::Auto;
+    Approximator approx;
+    ASSERT_TRUE(approx.SetOptions(opts));
+    ASSERT_TRUE(approx.SetCloud(xyz.data(), n, values.data(), 2));
+    const std::string& reason = approx.Report().MethodReason;
+    std::printf("Auto, %s: %s\n", which == 0 ? "cubic" : "thin-plate spline", reason.c_str());
+    EXPECT_EQ(approx.Report().MethodUsed, which == 0 ? "PU-WLS degree 3" : "RBF (global)") << reason;
+    EXPECT_NE(reason.find("leave-one-out"), std::string::npos) << reason;
+    const Result r = EvaluateAll(approx, Cloud(50, 2, 0.1, 0.8, 4000), 2);
+    ExpectFinite(r);
+    for (int i = 0; i < 50; ++i)
+    {
+      EXPECT_EQ(r.Valid[i], 1);
+      EXPECT_NEAR(r.Values[2 * i + 1], 2.5, 1e-12);
+    }
+  }
+  // Without values there is nothing to estimate: the spline, and the reason says why.
+  ApproximationOptions opts;
+  opts.Method = ApproximationMethod::Auto;
+  Approximator approx;
+  ASSERT_TRUE(approx.SetOptions(opts));
+  ASSERT_TRUE(approx.SetCloud(xyz.data(), n, nullptr, 0));
+  EXPECT_EQ(approx.Report().MethodUsed, "RBF (global)");
+  EXPECT_NE(approx.Report().MethodReason.find("no values"), std::string::npos) << approx.Report().MethodReason;
 }
 
 } // namespace

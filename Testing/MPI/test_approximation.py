@@ -43,6 +43,8 @@ elif kind == 'height':
     xyz = np.column_stack([xy, np.sin(3 * xy[:, 0]) * np.cos(2 * xy[:, 1])])
 elif kind == 'probe':
     xyz = 0.05 + 0.9 * rng.random((count, 3))
+elif kind == 'flat':
+    xyz = rng.random((count, 3)) * np.array([1.0, 1.0, 0.0])
 else:
     xyz = rng.random((count, 3))
 info = self.GetOutputInformation(0)
@@ -144,6 +146,9 @@ def run_case(label, cloud, method, support, probe, relative=1e-9, serial_cloud=N
     elapsed = time.time() - start
     got = mm.all_gather(table(local, probe is not None))
     want = table(mm.serial_output(serial, 0.0), probe is not None)
+    chosen = local.GetFieldData().GetAbstractArray("ApproximationMethod")
+    if mm.RANK == 0 and method == "Auto" and chosen is not None:
+        mm.log(f"{label}: Auto chose {chosen.GetValue(0)}")
     field = local.GetFieldData().GetArray("HaloPoints")
     mm.check(field is not None or mm.RANKS == 1, "no HaloPoints field array in a distributed run")
     halo = field.GetValue(0) if field is not None else 0
@@ -219,6 +224,14 @@ def main():
             label = f"{method}, global, {output}"
             results[label] = run_case(label, small_cloud, method, SUPPORTS["k-nearest"],
                                       probe_source if output == "probe" else None)
+
+    # Auto on a small 2D cloud (120 points <= 150): every rank gathers the cloud for the leave-one-out choice
+    # between the thin-plate spline and PU-WLS, and makes the serial run's choice.
+    flat_cloud = cloud_source("flat", 120, 23)
+    for output in ("grid", "probe"):
+        label = f"Auto, 2D cloud (leave-one-out choice), {output}"
+        results[label] = run_case(label, flat_cloud, "Auto", SUPPORTS["k-nearest"],
+                                  probe_source if output == "probe" else None)
 
     # SPH with Mass and Density (given volumes), and height fields.
     sph_cloud = cloud_source("sph", 2000, 3)

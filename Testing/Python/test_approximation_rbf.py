@@ -3,6 +3,7 @@ SciPy's RBFInterpolator (thin-plate spline in 2D, cubic r^3 in 3D, linear tail, 
 probe's points, interpolates the data, RBF-PU (RBFGlobalLimit below N) interpolates too and stays close to it,
 the field data say what ran and why, and duplicates and gradients give finite results."""
 import os
+import re
 import sys
 
 import numpy as np
@@ -89,26 +90,35 @@ for dim, n in ((2, 150), (3, 250)):
         assert "RBFGlobalLimit" in field_string(out, "ApproximationMethodReason")
         simple.Delete(approx)
 
-    # Through the data (the cloud as probe): global and RBF-PU both interpolate.
-    for limit, name in ((1000, "RBF (global)"), (0, "RBF-PU")):
-        approx = MeshlessApproximation(Input=cloud, Probe=cloud, Method="RBF", RBFGlobalLimit=limit)
+    # Through the data (the cloud as probe): global and RBF-PU both interpolate, with either kernel.
+    for (limit, name), kernel in [(c, k) for k in ("Polyharmonic", "Wendland C2")
+                                  for c in ((1000, "RBF (global)"), (0, "RBF-PU"))]:
+        approx = MeshlessApproximation(Input=cloud, Probe=cloud, Method="RBF", RBFGlobalLimit=limit,
+                                       RBFKernel=kernel)
         out = meshfree_test.fetch(approx)
         err = np.abs(np.asarray(out.PointData["f"]) - f).max()
-        print("%dD %s through the data: max error %.3g" % (dim, name, err))
+        print("%dD %s (%s) through the data: max error %.3g" % (dim, name, kernel, err))
         assert err <= 1e-10 * np.ptp(f), (name, err)
         assert field_string(out, "ApproximationMethod") == name
         simple.Delete(approx)
     simple.Delete(probe)
     simple.Delete(cloud)
 
-# Auto: the global RBF for a small cloud, PU-WLS above RBFGlobalLimit, MLS with smoothing; it says why.
-for n, smoothing, expected in ((200, 0.0, "RBF (global)"), (1500, 0.0, "PU-WLS degree 3"), (1500, 0.01, "MLS degree 2")):
+# Auto: for a small 2D cloud the global RBF or PU-WLS by their leave-one-out errors (the reason gives both; the
+# spline needs a 1.25x lower one), PU-WLS above 150 points, MLS with smoothing above RBFGlobalLimit; it says why.
+for n, smoothing, expected in ((100, 0.0, None), (200, 0.0, "PU-WLS degree 3"), (1500, 0.0, "PU-WLS degree 3"),
+                               (1500, 0.01, "MLS degree 2")):
     xyz = np.column_stack([halton(n, 2), halton(n, 3), np.zeros(n)])
     cloud = source(polydata(xyz, {"f": field(xyz)}))
     approx = MeshlessApproximation(Input=cloud, Method="Auto", Smoothing=smoothing, SampleDimensions=[31, 31, 1])
     out = meshfree_test.fetch(approx)
     chosen, reason = field_string(out, "ApproximationMethod"), field_string(out, "ApproximationMethodReason")
     print("Auto, N = %d, smoothing %g: %s (%s)" % (n, smoothing, chosen, reason))
+    if expected is None:
+        found = re.search(r"thin-plate spline ([0-9.e+-]+), of PU-WLS degree 3 ([0-9.e+-]+)", reason)
+        assert found, reason
+        spline, pu = float(found.group(1)), float(found.group(2))
+        expected = "RBF (global)" if spline * 1.25 < pu else "PU-WLS degree 3"
     assert chosen == expected, chosen
     assert reason and str(n) in reason, reason
     assert np.all(np.asarray(out.PointData["vtkValidPointMask"]) == 1)

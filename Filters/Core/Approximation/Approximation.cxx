@@ -101,6 +101,11 @@ bool Approximator::SetOptions(const ApproximationOptions& options)
     this->Err = "the RBF tail's degree must be 0..3";
     return false;
   }
+  if (options.RBFKernel != RBFKernelType::Polyharmonic && options.RBFKernel != RBFKernelType::WendlandC2)
+  {
+    this->Err = "unknown RBF kernel";
+    return false;
+  }
   if (options.RBFGlobalLimit < 0 || options.PatchPoints < 0)
   {
     this->Err = "RBFGlobalLimit and PatchPoints must be >= 0";
@@ -313,7 +318,7 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
     }
   }
   this->Rep.CloudDimension = dim;
-  this->ResolveAuto(globalValid, dim);
+  this->ResolveAuto(globalValid, dim, partition);
 
   // What else is global, over every part of a distributed cloud (collective, in this order on every part).
   if (partition)
@@ -342,7 +347,8 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
       }
     }
     else if (this->Opts.Method == ApproximationMethod::PUWLS ||
-      (this->Opts.Method == ApproximationMethod::RBF && !this->RBFIsGlobal()))
+      (this->Opts.Method == ApproximationMethod::RBF &&
+        (!this->RBFIsGlobal() || this->Opts.RBFKernel == RBFKernelType::WendlandC2)))
     {
       double box[6] = { 0, 0, 0, 0, 0, 0 }; // -umin, umax per axis of the frame
       for (int a = 0; a < dim; ++a)

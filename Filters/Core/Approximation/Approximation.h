@@ -100,6 +100,13 @@ enum class ApproximationBackend
 /// measured on a GPU.
 constexpr double kAutoDeviceWork = 1e6;
 
+/// Method RBF's kernel (ApproximationOptions::RBFKernel).
+enum class RBFKernelType
+{
+  Polyharmonic = 0,
+  WendlandC2 = 1
+};
+
 struct ApproximationOptions
 {
   ApproximationMethod Method = ApproximationMethod::MLS;
@@ -123,6 +130,11 @@ struct ApproximationOptions
   int TailDegree = 1;
   Index RBFGlobalLimit = 1000;
   int PatchPoints = 0;
+  // The RBF kernel: polyharmonic (no shape parameter) or Wendland's C2 function (1 - r/rho)^4 (4 r/rho + 1),
+  // compactly supported, positive definite in 1 to 3 dimensions; rho = SupportRadius when set, else
+  // SupportFactor x the RBF-PU cover radius (a ball holding about PatchPoints points) for the global fit, and
+  // each RBF-PU patch's support radius for its fit.
+  RBFKernelType RBFKernel = RBFKernelType::Polyharmonic;
 };
 
 /// Where the results go (m evaluation points, C components). Null pointers switch outputs off.
@@ -147,6 +159,9 @@ struct CloudPartition
   std::function<void(double* values, int n)> Sum;
   std::function<void(double* values, int n)> Max;
   const unsigned char* Owned = nullptr;
+  /// Every part's `mine` appended in part order to `all`, the same on every part (an all-gather). Auto gathers
+  /// the few points of a small 2D cloud with it for its leave-one-out choice; null: Auto chooses by size alone.
+  std::function<void(const std::vector<double>& mine, std::vector<double>& all)> Gather;
 };
 
 /// What the evaluation at a set of points reads of the cloud (Approximator::Reach): the neighbourhoods of
@@ -296,6 +311,21 @@ private:
   PointResult MLSPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult SPHPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
   PointResult PUPoint(const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const;
+  /// One PU-WLS centre's fit at x (cover radius R): support SupportRadius, or max(SupportFactor d_k,
+  /// SupportFactor R), the fit over the points within it at Options.Degree, then at twice the support from
+  /// Options.Degree down to 0. Returns the degree used (coefficients, condition, the support h and the number m of
+  /// weighted points, which are s.Ids / s.Xi / s.Weights [0, m)), or -1: no fit, or no point within R (the centre
+  /// blends nothing).
+  int FitPUCentre(const double x[3], double R, FitScratch& s, double* coefficients, double& condition, double& h,
+    int& m) const;
+  /// The partition of unity at x, shared by PU-WLS and RBF-PU (ApproximationPU.h): the centres (positions xyz,
+  /// found in grid) within R weighted by theta(|x - x_c| / R), each centre's local fit given by
+  /// local(c, dx, values, gradients) - values (C) and, when gradients is not null, their gradients (D x C, per
+  /// unit length along the frame's axes) at dx = x - x_c -, blended by WriteBlend; info(c, result) fills
+  /// Neighbors, Condition and Lowered from the centre of largest weight.
+  template <class Local, class Info>
+  PointResult BlendCentres(const double x[3], const NeighborGrid& grid, const double* xyz, double R, FitScratch& s,
+    const ApproximationOutput& out, Index i, const Local& local, const Info& info) const;
   PointResult GlobalPoint(const double x[3], const ApproximationOutput& out, Index i) const;
   /// The partition of unity's last step (3.16-3.21), shared by PU-WLS and RBF-PU: the blended values
   /// sum(theta L) / sum(theta) and gradients of output point i from the sums (sumGrad and sumDTheta in the
@@ -304,7 +334,18 @@ private:
     const ApproximationOutput& out) const;
   /// RBF (ApproximationRBF.cxx): Auto's choice for the cloud (SetCloud), the duplicates' merge and the global
   /// fit or the RBF-PU patches that blend into the m points xyz; the evaluation at one point.
-  void ResolveAuto(Index globalValid, int dimension);
+  void ResolveAuto(Index globalValid, int dimension, const CloudPartition* partition);
+  /// Auto's estimate for a small 2D cloud (ApproximationRBF.cxx): the leave-one-out errors of the global
+  /// thin-plate spline and of PU-WLS over the valid points (every part's, gathered); false when either is not
+  /// defined (no component, a singular system, ...). errors[0]: spline, errors[1]: PU-WLS, each the rms over the
+  /// points of the residuals relative to the values' standard deviation, over the components.
+  bool AutoLeaveOneOut(const CloudPartition* partition, double errors[2]) const;
+  /// Leave-one-out residuals (f - the fit without that point) of every valid point (by id, n x C, NaN where
+  /// not defined) of this cloud (not distributed): the global polyharmonic spline (Rippa's formula, see
+  /// SolvePolyharmonic), PU-WLS (each patch's weighted fit without the point, from its hat matrix's diagonal:
+  /// r / (1 - h_jj); the patches and supports as the full cloud's).
+  bool LeaveOneOutRBF(std::vector<double>& residuals);
+  bool LeaveOneOutPU(std::vector<double>& residuals) const;
   bool RBFIsGlobal() const;
   int PatchSize() const;
   bool PrepareRBF(const double* xyz, Index m);
@@ -359,6 +400,7 @@ private:
   double GlobalCondition = 0.0;
   std::unique_ptr<PUData> PU;
   std::unique_ptr<RBFData> RBFFits;
+  bool RBFLeaveOneOut = false; // PrepareRBF also computes the global fit's leave-one-out residuals (Auto)
   ApproximationMethod Requested = ApproximationMethod::MLS; // Opts.Method before Auto was resolved
   std::unique_ptr<cuda::MLSDevice> Device; // the cloud on the CUDA device (uploaded on first use)
   bool DeviceUploaded = false;

@@ -142,12 +142,44 @@ double Approximator::PUCentresNear(const double* xyz, Index m, std::vector<doubl
   return cover;
 }
 
+int Approximator::FitPUCentre(const double x[3], double R, FitScratch& s, double* coefficients, double& condition,
+  double& h, int& m) const
+{
+  if (this->Opts.SupportRadius > 0.0)
+  {
+    h = this->Opts.SupportRadius;
+  }
+  else
+  {
+    this->Neighbors(x, this->Opts.NeighborCount, 0.0, s, h);
+    h = std::max(h, this->Opts.SupportFactor * R);
+  }
+  m = 0;
+  for (int attempt = 0; attempt < 2; ++attempt, h *= 2.0)
+  {
+    this->Points.FindWithinRadius(x, h, s.Ids, &s.Dist2);
+    this->SortNeighbors(s, s.Ids.size());
+    const int n = static_cast<int>(s.Ids.size());
+    if (attempt == 0 && !std::any_of(s.Dist2.begin(), s.Dist2.end(), [&](double d2) { return d2 < R * R; }))
+    {
+      return -1; // no data inside its cover region: the centre blends nothing
+    }
+    s.Reserve(static_cast<size_t>(std::max(n, 1)));
+    m = this->GatherWeighted(x, n, h, s);
+    const int degree = this->FitDescending(attempt == 0 ? this->Opts.Degree : 0, s, m, coefficients, condition);
+    if (degree >= 0)
+    {
+      return degree;
+    }
+  }
+  return -1;
+}
+
 bool Approximator::PreparePU(const double* xyz, Index count)
 {
   this->PU.reset(new PUData);
   PUData& pu = *this->PU;
   const int C = this->NumberOfComponents;
-  const int k = this->Opts.NeighborCount;
   // Only the centres within R of the evaluation points can blend into them: the others are not fitted.
   std::vector<double> centers;
   const double cover = this->PUCentresNear(xyz, count, centers);
@@ -162,40 +194,14 @@ bool Approximator::PreparePU(const double* xyz, Index count)
     FitScratch& s = scratch.Local();
     for (Index node = begin; node < end; ++node)
     {
-      const double* x = &centers[3 * node];
       double h = 0.0;
-      if (this->Opts.SupportRadius > 0.0)
+      int m = 0;
+      degrees[node] =
+        this->FitPUCentre(&centers[3 * node], cover, s, &coefficients[stride * node], conditions[node], h, m);
+      if (degrees[node] >= 0)
       {
-        h = this->Opts.SupportRadius;
-      }
-      else
-      {
-        this->Neighbors(x, k, 0.0, s, h);
-        h = std::max(h, this->Opts.SupportFactor * cover);
-      }
-      for (int attempt = 0; attempt < 2 && degrees[node] < 0; ++attempt, h *= 2.0)
-      {
-        this->Points.FindWithinRadius(x, h, s.Ids, &s.Dist2);
-        this->SortNeighbors(s, s.Ids.size());
-        const int n = static_cast<int>(s.Ids.size());
-        if (attempt == 0)
-        {
-          // A centre with no data inside its cover region blends nothing: drop it.
-          const bool covered = std::any_of(s.Dist2.begin(), s.Dist2.end(), [&](double d2) { return d2 < cover * cover; });
-          if (!covered)
-          {
-            break;
-          }
-        }
-        s.Reserve(static_cast<size_t>(std::max(n, 1)));
-        const int m = this->GatherWeighted(x, n, h, s);
-        degrees[node] = this->FitDescending(
-          attempt == 0 ? this->Opts.Degree : 0, s, m, &coefficients[stride * node], conditions[node]);
-        if (degrees[node] >= 0)
-        {
-          fitCounts[node] = m;
-          supports[node] = h;
-        }
+        fitCounts[node] = m;
+        supports[node] = h;
       }
     }
   });
@@ -228,76 +234,26 @@ bool Approximator::PreparePU(const double* xyz, Index count)
 Approximator::PointResult Approximator::PUPoint(
   const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const
 {
-  PointResult result{ false, 0, 0.0, false, false };
   const PUData& pu = *this->PU;
   const int D = this->Frame.Dimension;
   const int C = this->NumberOfComponents;
-  const bool gradient = out.Gradients != nullptr;
   const size_t stride = static_cast<size_t>(kMaxBasisSize) * C;
-  const double R = pu.CoverRadius;
-  pu.CenterGrid.FindWithinRadius(x, R, s.Ids, &s.Dist2);
-  SortById(s, s.Ids.size()); // centres in lattice order, whichever were fitted
-  // Work: blended values (C), blended local gradients (3C), one centre's values (C) and gradients (3C).
-  s.Work.resize(8 * static_cast<size_t>(C) + 8);
-  double* sumValues = s.Work.data();
-  double* sumGrad = sumValues + C;
-  double* local = sumGrad + 3 * C;
-  double* localGrad = local + C;
-  std::fill(sumValues, sumValues + 4 * C, 0.0);
-  double sumTheta = 0.0;
-  double sumDTheta[3] = { 0, 0, 0 };
-  double best = 0.0;
-  for (size_t j = 0; j < s.Ids.size(); ++j)
-  {
-    const double theta = this->UnitKernel.ValueSquared(s.Dist2[j] / (R * R));
-    if (!(theta > 0.0))
-    {
-      continue;
-    }
-    const Index c = s.Ids[j];
-    const double* xc = &pu.Centers[3 * c];
-    const double dx[3] = { x[0] - xc[0], x[1] - xc[1], x[2] - xc[2] };
+  auto local = [&](Index c, const double dx[3], double* values, double* gradients) {
     double xi[3] = { 0, 0, 0 };
-    this->Frame.Project<3>(dx, 1.0 / pu.Supports[c], xi);
-    EvaluateFit(D, pu.Degrees[c], xi, &pu.Coefficients[stride * c], C, local, gradient ? localGrad : nullptr);
-    sumTheta += theta;
-    for (int q = 0; q < C; ++q)
+    const double support = pu.Supports[c];
+    this->Frame.Project<3>(dx, 1.0 / support, xi);
+    EvaluateFit(D, pu.Degrees[c], xi, &pu.Coefficients[stride * c], C, values, gradients);
+    for (int a = 0; gradients && a < D * C; ++a)
     {
-      sumValues[q] += theta * local[q];
+      gradients[a] /= support; // per unit xi -> per unit length
     }
-    if (gradient)
-    {
-      double r[3] = { 0, 0, 0 }, dTheta[3];
-      this->Frame.Project<3>(dx, 1.0 / R, r);
-      for (int a = D; a < 3; ++a)
-      {
-        r[a] = 0.0;
-      }
-      this->UnitKernel.Gradient(r, dTheta); // per unit r / R
-      for (int a = 0; a < D; ++a)
-      {
-        dTheta[a] /= R;
-        sumDTheta[a] += dTheta[a];
-        for (int q = 0; q < C; ++q)
-        {
-          sumGrad[a * C + q] += dTheta[a] * local[q] + theta * localGrad[a * C + q] / pu.Supports[c];
-        }
-      }
-    }
-    if (theta > best)
-    {
-      best = theta;
-      result.Neighbors = pu.Counts[c];
-      result.Condition = pu.Conditions[c];
-      result.Lowered = pu.Degrees[c] < this->Opts.Degree;
-    }
-  }
-  if (!(sumTheta > 0.0))
-  {
-    return result;
-  }
-  result.Valid = this->WriteBlend(i, sumValues, sumGrad, sumDTheta, sumTheta, out);
-  return result;
+  };
+  auto info = [&](Index c, PointResult& result) {
+    result.Neighbors = pu.Counts[c];
+    result.Condition = pu.Conditions[c];
+    result.Lowered = pu.Degrees[c] < this->Opts.Degree;
+  };
+  return this->BlendCentres(x, pu.CenterGrid, pu.Centers.data(), pu.CoverRadius, s, out, i, local, info);
 }
 
 bool Approximator::WriteBlend(Index i, const double* sumValues, const double* sumGrad, const double* sumDTheta,

@@ -60,6 +60,78 @@ inline double BoxDistance2(const double box[6], const double x[3])
   }
   return d2;
 }
+template <class Local, class Info>
+Approximator::PointResult Approximator::BlendCentres(const double x[3], const NeighborGrid& grid, const double* xyz,
+  double R, FitScratch& s, const ApproximationOutput& out, Index i, const Local& local, const Info& info) const
+{
+  PointResult result{ false, 0, 0.0, false, false };
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const bool gradient = out.Gradients != nullptr;
+  grid.FindWithinRadius(x, R, s.Ids, &s.Dist2);
+  SortById(s, s.Ids.size()); // centres in lattice order, whichever were fitted
+  // Work: blended values (C), blended local gradients (3C), one centre's values (C) and gradients (3C).
+  if (s.Work.size() < 8 * static_cast<size_t>(C) + 8)
+  {
+    s.Work.resize(8 * static_cast<size_t>(C) + 8);
+  }
+  double* sumValues = s.Work.data();
+  double* sumGrad = sumValues + C;
+  double* values = sumGrad + 3 * C;
+  double* gradients = values + C;
+  std::fill(sumValues, sumValues + 4 * C, 0.0);
+  double sumTheta = 0.0;
+  double sumDTheta[3] = { 0, 0, 0 };
+  double best = 0.0;
+  for (size_t j = 0; j < s.Ids.size(); ++j)
+  {
+    const double theta = this->UnitKernel.ValueSquared(s.Dist2[j] / (R * R));
+    if (!(theta > 0.0))
+    {
+      continue;
+    }
+    const Index c = s.Ids[j];
+    const double* xc = xyz + 3 * c;
+    const double dx[3] = { x[0] - xc[0], x[1] - xc[1], x[2] - xc[2] };
+    local(c, dx, values, gradient ? gradients : nullptr);
+    sumTheta += theta;
+    for (int q = 0; q < C; ++q)
+    {
+      sumValues[q] += theta * values[q];
+    }
+    if (gradient)
+    {
+      double r[3] = { 0, 0, 0 }, dTheta[3];
+      this->Frame.Project<3>(dx, 1.0 / R, r);
+      for (int a = D; a < 3; ++a)
+      {
+        r[a] = 0.0;
+      }
+      this->UnitKernel.Gradient(r, dTheta); // per unit r / R
+      for (int a = 0; a < D; ++a)
+      {
+        dTheta[a] /= R;
+        sumDTheta[a] += dTheta[a];
+        for (int q = 0; q < C; ++q)
+        {
+          sumGrad[a * C + q] += dTheta[a] * values[q] + theta * gradients[a * C + q];
+        }
+      }
+    }
+    if (theta > best)
+    {
+      best = theta;
+      info(c, result);
+    }
+  }
+  if (!(sumTheta > 0.0))
+  {
+    return result;
+  }
+  result.Valid = this->WriteBlend(i, sumValues, sumGrad, sumDTheta, sumTheta, out);
+  return result;
+}
+
 } // namespace meshfree
 
 #endif

@@ -21,8 +21,13 @@ namespace meshfree
 {
 
 bool SolvePolyharmonic(int D, int beta, int degree, double lambda, const double* xi, Index n, const double* f, int C,
-  double* w, double* tail, PolyharmonicFit& fit)
+  double* w, double* tail, PolyharmonicFit& fit, double* leaveOneOut)
 {
+  if (leaveOneOut)
+  {
+    std::fill(leaveOneOut, leaveOneOut + static_cast<size_t>(std::max<Index>(n, 0)) * C,
+      std::numeric_limits<double>::quiet_NaN());
+  }
   using Matrix = Eigen::MatrixXd;
   fit.Condition = std::numeric_limits<double>::infinity();
   fit.Regularized = false;
@@ -69,7 +74,7 @@ bool SolvePolyharmonic(int D, int beta, int degree, double lambda, const double*
   for (Index i = 0; i < n; ++i)
   {
     const double* a = xi + 3 * i;
-    B(i, i) = lambda;
+    B(i, i) = lambda + PolyharmonicValue(beta, 0.0); // phi(0): 0 for the polyharmonic kernels, 1 for Wendland's
     for (Index j = 0; j < i; ++j)
     {
       const double* b = xi + 3 * j;
@@ -96,6 +101,7 @@ bool SolvePolyharmonic(int D, int beta, int degree, double lambda, const double*
   G.applyOnTheLeft(qr.householderQ().transpose());
   const Index m = n - q;
   Matrix Z(m, C);
+  Eigen::VectorXd inverseDiagonal; // (A^-1)_jj for the leave-one-out residuals
   if (m > 0)
   {
     const auto B22 = B.bottomRightCorner(m, m);
@@ -105,6 +111,15 @@ bool SolvePolyharmonic(int D, int beta, int degree, double lambda, const double*
     {
       Z = llt.solve(G.bottomRows(m));
       fit.Condition = 1.0 / rcond;
+      if (leaveOneOut && lambda == 0.0)
+      {
+        // diag(Q2 B22^-1 Q2^T) = the squared column norms of L^-1 Q2^T (B22 = L L^T).
+        Matrix Q2t = Matrix::Identity(n, n);
+        Q2t.applyOnTheLeft(qr.householderQ().transpose());
+        Matrix Y = Q2t.bottomRows(m);
+        llt.matrixL().solveInPlace(Y);
+        inverseDiagonal = Y.colwise().squaredNorm().transpose();
+      }
     }
     else
     {
@@ -160,6 +175,17 @@ bool SolvePolyharmonic(int D, int beta, int degree, double lambda, const double*
       w[j * C + k] = Wm(j, k);
     }
   }
+  if (leaveOneOut && inverseDiagonal.size() == n)
+  {
+    for (Index j = 0; j < n; ++j)
+    {
+      const double d = inverseDiagonal(j);
+      for (int k = 0; k < C; ++k)
+      {
+        leaveOneOut[j * C + k] = d > 0.0 ? Wm(j, k) / d : std::numeric_limits<double>::quiet_NaN();
+      }
+    }
+  }
   std::fill(tail, tail + static_cast<size_t>(kMaxBasisSize) * C, 0.0);
   for (int a = 0; a < q; ++a)
   {
@@ -182,7 +208,7 @@ void EvaluatePolyharmonic(int D, int beta, const PolyharmonicFit& fit, const dou
   {
     // The common case (one scalar field): a tight loop.
     double sum = 0.0;
-    if (D == 2)
+    if (D == 2 && beta == 2)
     {
       for (Index j = 0; j < n; ++j)
       {
@@ -251,21 +277,27 @@ int Approximator::PatchSize() const
                                     : kRBFPatchPoints[std::min(std::max(this->Frame.Dimension, 0), 3)];
 }
 
-void Approximator::ResolveAuto(Index globalValid, int dimension)
+void Approximator::ResolveAuto(Index globalValid, int dimension, const CloudPartition* partition)
 {
   this->Opts.Method = this->Requested;
-  char text[320];
+  char text[400];
   if (this->Requested == ApproximationMethod::Auto)
   {
     // Measured with Testing/Benchmarks/run_benchmarks.py (Renka & Brown's ten functions in 2D, a 3D Franke field,
-    // N = 100 to 10,000; README, "Run time against error"). 2D: the global thin-plate spline is the most accurate
-    // MeshFree setting on 8 of 10 functions at N = 100, PU-WLS of degree 3 is within 2x of the best error at a
-    // fraction of the time on every function from N = 300 on (degree 3 converges like h^4, the thin-plate
-    // spline like h^2). 1D and 3D: r^3 (global, RBF-PU above RBFGlobalLimit) is the most accurate at every N
-    // measured. With smoothing (noisy data): the smoothing spline up to RBFGlobalLimit, a moving least-squares fit
-    // (which does not interpolate) above.
+    // N = 100 to 10,000; README, "Run time against error"). 2D: at N = 100 the global thin-plate spline is the
+    // most accurate MeshFree setting on 8 of 10 functions and PU-WLS of degree 3 on the other two (F6, a
+    // sphere's cap, by 8.7x; F7, oscillating, by 1.1x), at a quarter of the spline's time; from N = 300 on
+    // PU-WLS of degree 3 is within 2x of the best error at a fraction of the time on every function (degree 3
+    // converges like h^4, the thin-plate spline like h^2). Up to kAutoRBFPoints2D points, where neither wins
+    // everywhere, the leave-one-out errors of both decide (cheap there: a dense system of <= 200 rows and ~50
+    // small patch fits); the spline must beat PU-WLS's estimate by kAutoRBFMargin to pay for its time.
+    // 1D and 3D: r^3 (global, RBF-PU above RBFGlobalLimit) is the most accurate at every N measured. With
+    // smoothing (noisy data): the smoothing spline up to RBFGlobalLimit, a moving least-squares fit (which does
+    // not interpolate) above.
     const bool smoothing = this->Opts.Smoothing > 0.0;
+    this->Opts.RBFKernel = RBFKernelType::Polyharmonic; // the kernel measured
     const Index small2D = std::min<Index>(kAutoRBFPoints2D, this->Opts.RBFGlobalLimit);
+    const int puDegree = std::max(this->Opts.Degree, 3);
     if (dimension == 0)
     {
       this->Opts.Method = ApproximationMethod::RBF;
@@ -284,28 +316,46 @@ void Approximator::ResolveAuto(Index globalValid, int dimension)
     else if (dimension == 2 && globalValid > small2D)
     {
       this->Opts.Method = ApproximationMethod::PUWLS;
-      this->Opts.Degree = std::max(this->Opts.Degree, 3);
+      this->Opts.Degree = puDegree;
       std::snprintf(text, sizeof(text),
         "2D cloud of %lld valid points > %lld: PU-WLS of degree %d, as accurate as the thin-plate spline or more "
         "(it converges faster) at a fraction of its time",
         static_cast<long long>(globalValid), static_cast<long long>(small2D), this->Opts.Degree);
     }
+    else if (dimension == 2)
+    {
+      double loo[2] = { 0.0, 0.0 };
+      const bool estimated = this->AutoLeaveOneOut(partition, loo);
+      const bool spline = !estimated || loo[0] * kAutoRBFMargin < loo[1];
+      this->Opts.Method = spline ? ApproximationMethod::RBF : ApproximationMethod::PUWLS;
+      if (!spline)
+      {
+        this->Opts.Degree = puDegree;
+      }
+      if (!estimated)
+      {
+        std::snprintf(text, sizeof(text),
+          "2D cloud of %lld valid points <= %lld: the global thin-plate spline (no leave-one-out estimate: %s)",
+          static_cast<long long>(globalValid), static_cast<long long>(small2D),
+          this->NumberOfComponents == 0 ? "no values" : "not defined for this cloud");
+      }
+      else
+      {
+        std::snprintf(text, sizeof(text),
+          "2D cloud of %lld valid points <= %lld: leave-one-out error (rms / std of the values) of the thin-plate "
+          "spline %.3g, of PU-WLS degree %d %.3g: %s",
+          static_cast<long long>(globalValid), static_cast<long long>(small2D), loo[0], puDegree, loo[1],
+          spline ? "the spline (more accurate by more than its margin of 1.25x, which pays for its time)"
+                 : "PU-WLS (as accurate within the margin of 1.25x, at a fraction of the spline's time)");
+      }
+    }
     else
     {
       this->Opts.Method = ApproximationMethod::RBF;
       const bool global = globalValid <= this->Opts.RBFGlobalLimit;
-      if (dimension == 2)
-      {
-        std::snprintf(text, sizeof(text),
-          "2D cloud of %lld valid points <= %lld: the global thin-plate spline, the most accurate at this size",
-          static_cast<long long>(globalValid), static_cast<long long>(small2D));
-      }
-      else
-      {
-        std::snprintf(text, sizeof(text), "%dD cloud of %lld valid points: the polyharmonic spline r^3 (%s), the most "
-                                          "accurate here",
-          dimension, static_cast<long long>(globalValid), global ? "one global fit" : "RBF-PU above RBFGlobalLimit");
-      }
+      std::snprintf(text, sizeof(text), "%dD cloud of %lld valid points: the polyharmonic spline r^3 (%s), the most "
+                                        "accurate here",
+        dimension, static_cast<long long>(globalValid), global ? "one global fit" : "RBF-PU above RBFGlobalLimit");
     }
     this->Rep.MethodReason = text;
   }
@@ -331,12 +381,230 @@ void Approximator::ResolveAuto(Index globalValid, int dimension)
   }
 }
 
+bool Approximator::AutoLeaveOneOut(const CloudPartition* partition, double errors[2]) const
+{
+  const int C = this->NumberOfComponents;
+  if (C == 0 || (partition && !partition->Gather))
+  {
+    return false;
+  }
+  // This part's own valid points (position, values), gathered over every part when distributed. The estimate
+  // runs on a serial copy of the whole (small) cloud, whose result does not depend on the points' order: the
+  // same choice on every part and in a serial run.
+  const Index nv = this->Points.NumberOfValidPoints();
+  const double* sp = this->Points.SortedPoints();
+  const std::vector<Index>& order = this->Points.SortedOrder();
+  const size_t stride = 3 + static_cast<size_t>(C);
+  std::vector<double> mine, all;
+  mine.reserve(stride * static_cast<size_t>(nv));
+  for (Index p = 0; p < nv; ++p)
+  {
+    const Index id = order[p];
+    if (partition && partition->Owned && !partition->Owned[id])
+    {
+      continue;
+    }
+    mine.insert(mine.end(), sp + 3 * p, sp + 3 * p + 3);
+    mine.insert(mine.end(), &this->Values[static_cast<size_t>(id) * C], &this->Values[static_cast<size_t>(id) * C] + C);
+  }
+  if (partition)
+  {
+    partition->Gather(mine, all);
+  }
+  else
+  {
+    all.swap(mine);
+  }
+  const Index n = static_cast<Index>(all.size() / stride);
+  std::vector<double> xyz(3 * static_cast<size_t>(n)), values(static_cast<size_t>(n) * C);
+  for (Index i = 0; i < n; ++i)
+  {
+    std::copy_n(&all[stride * i], 3, &xyz[3 * i]);
+    std::copy_n(&all[stride * i + 3], C, &values[static_cast<size_t>(i) * C]);
+  }
+  ApproximationOptions options = this->Opts;
+  options.Method = ApproximationMethod::PUWLS;
+  options.Degree = std::max(this->Opts.Degree, 3);
+  options.Diagnostics = false;
+  options.ComputeGradients = false;
+  options.Smoothing = 0.0;
+  options.RBFKernel = RBFKernelType::Polyharmonic;
+  options.RBFGlobalLimit = std::max<Index>(n, 1);
+  Approximator trial;
+  std::vector<double> splineLOO, puLOO;
+  if (!trial.SetOptions(options) || !trial.SetCloud(xyz.data(), n, values.data(), C) ||
+    trial.CloudDimension() != 2 || !trial.LeaveOneOutPU(puLOO))
+  {
+    return false;
+  }
+  trial.Opts.Method = ApproximationMethod::RBF;
+  if (!trial.LeaveOneOutRBF(splineLOO))
+  {
+    return false;
+  }
+  // Over the points where both are defined, in the cloud's sorted order (independent of the input's order):
+  // per component the rms of the residuals relative to the values' standard deviation, then the rms over the
+  // components (a constant component, fitted exactly by both, is left out).
+  const Index tn = trial.Points.NumberOfValidPoints();
+  const std::vector<Index>& tOrder = trial.Points.SortedOrder();
+  double sums[2] = { 0.0, 0.0 };
+  int used = 0;
+  for (int c = 0; c < C; ++c)
+  {
+    double mean = 0.0, count = 0.0;
+    double squares[2] = { 0.0, 0.0 };
+    for (Index p = 0; p < tn; ++p)
+    {
+      const size_t at = static_cast<size_t>(tOrder[p]) * C + c;
+      if (std::isfinite(splineLOO[at]) && std::isfinite(puLOO[at]))
+      {
+        mean += trial.Values[at];
+        count += 1.0;
+      }
+    }
+    if (count < 0.5 * static_cast<double>(tn) || count < 3.0)
+    {
+      return false; // the estimate would rest on too few points
+    }
+    mean /= count;
+    double variance = 0.0;
+    for (Index p = 0; p < tn; ++p)
+    {
+      const size_t at = static_cast<size_t>(tOrder[p]) * C + c;
+      if (std::isfinite(splineLOO[at]) && std::isfinite(puLOO[at]))
+      {
+        variance += (trial.Values[at] - mean) * (trial.Values[at] - mean);
+        squares[0] += splineLOO[at] * splineLOO[at];
+        squares[1] += puLOO[at] * puLOO[at];
+      }
+    }
+    if (!(variance > 0.0))
+    {
+      continue;
+    }
+    sums[0] += squares[0] / variance;
+    sums[1] += squares[1] / variance;
+    ++used;
+  }
+  if (used == 0)
+  {
+    return false;
+  }
+  errors[0] = std::sqrt(sums[0] / used);
+  errors[1] = std::sqrt(sums[1] / used);
+  return std::isfinite(errors[0]) && std::isfinite(errors[1]);
+}
+
+bool Approximator::LeaveOneOutRBF(std::vector<double>& residuals)
+{
+  this->RBFLeaveOneOut = true;
+  const bool ok = this->PrepareRBF(nullptr, 0) && this->RBFFits && this->RBFFits->Global;
+  this->RBFLeaveOneOut = false;
+  if (!ok)
+  {
+    return false;
+  }
+  residuals.swap(this->RBFFits->LeaveOneOut);
+  return !residuals.empty();
+}
+
+bool Approximator::LeaveOneOutPU(std::vector<double>& residuals) const
+{
+  const int D = this->Frame.Dimension;
+  const int C = this->NumberOfComponents;
+  const Index n = static_cast<Index>(this->Coordinates.size() / 3);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  residuals.assign(static_cast<size_t>(n) * C, nan);
+  if (D <= 0 || C == 0)
+  {
+    return false;
+  }
+  // The centres within R of the cloud's points, fitted as PreparePU fits them; for each fit and each point j
+  // in it that the fit blends into (|x_j - x_c| < R), the fit's value at x_j without point j:
+  // f_j - (f_j - L(x_j)) / (1 - h_jj), h_jj = w_j b_j^T M^-1 b_j (M = sum w b b^T, the weighted fit's hat
+  // matrix), blended there by theta as PUPoint blends.
+  std::vector<double> centers;
+  const double R = this->PUCentresNear(this->Points.SortedPoints(), this->Points.NumberOfValidPoints(), centers);
+  const Index nodes = static_cast<Index>(centers.size() / 3);
+  const size_t stride = static_cast<size_t>(kMaxBasisSize) * C;
+  std::vector<double> sums(static_cast<size_t>(n) * C, 0.0), thetas(static_cast<size_t>(n), 0.0);
+  std::vector<unsigned char> undefined(static_cast<size_t>(n), 0);
+  std::vector<double> coefficients(stride), local(static_cast<size_t>(C));
+  FitScratch s;
+  for (Index node = 0; node < nodes; ++node)
+  {
+    const double* x = &centers[3 * node];
+    double h = 0.0, condition = 0.0;
+    int m = 0;
+    const int degree = this->FitPUCentre(x, R, s, coefficients.data(), condition, h, m);
+    if (degree < 0)
+    {
+      continue;
+    }
+    const RuntimeBasis basis(D, degree);
+    const int q = basis.Size();
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(q, q);
+    double row[kMaxBasisSize];
+    for (int j = 0; j < m; ++j)
+    {
+      basis.Evaluate(&s.Xi[3 * j], row);
+      const Eigen::Map<const Eigen::VectorXd> b(row, q);
+      M.noalias() += s.Weights[j] * (b * b.transpose());
+    }
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(M);
+    if (ldlt.info() != Eigen::Success)
+    {
+      continue;
+    }
+    for (int j = 0; j < m; ++j)
+    {
+      const Index id = s.Ids[j];
+      const double* xj = &this->Coordinates[3 * id];
+      const double d2 =
+        (xj[0] - x[0]) * (xj[0] - x[0]) + (xj[1] - x[1]) * (xj[1] - x[1]) + (xj[2] - x[2]) * (xj[2] - x[2]);
+      const double theta = this->UnitKernel.ValueSquared(d2 / (R * R));
+      if (!(theta > 0.0))
+      {
+        continue;
+      }
+      basis.Evaluate(&s.Xi[3 * j], row);
+      const Eigen::Map<const Eigen::VectorXd> b(row, q);
+      const double leverage = s.Weights[j] * b.dot(ldlt.solve(b));
+      if (!(leverage < 1.0 - 1e-8) || !std::isfinite(leverage))
+      {
+        undefined[id] = 1; // the fit passes through x_j whatever the others: no estimate without it
+        continue;
+      }
+      EvaluateFit(D, degree, &s.Xi[3 * j], coefficients.data(), C, local.data(), nullptr);
+      thetas[id] += theta;
+      for (int c = 0; c < C; ++c)
+      {
+        const double f = this->Values[static_cast<size_t>(id) * C + c];
+        sums[static_cast<size_t>(id) * C + c] += theta * (f - (f - local[c]) / (1.0 - leverage));
+      }
+    }
+  }
+  for (Index id = 0; id < n; ++id)
+  {
+    if (thetas[id] > 0.0 && !undefined[id])
+    {
+      for (int c = 0; c < C; ++c)
+      {
+        const size_t at = static_cast<size_t>(id) * C + c;
+        residuals[at] = this->Values[at] - sums[at] / thetas[id];
+      }
+    }
+  }
+  return true;
+}
+
 namespace
 {
-/// The kernel's exponent beta in the cloud's intrinsic dimension: r^2 log r in 2D, r^3 otherwise.
-int KernelBeta(int dimension)
+/// The kernel's exponent beta in the cloud's intrinsic dimension: r^2 log r in 2D, r^3 otherwise (kWendlandBeta
+/// for Wendland's C2 kernel).
+int KernelBeta(int dimension, RBFKernelType kernel)
 {
-  return dimension == 2 ? 2 : 3;
+  return kernel == RBFKernelType::WendlandC2 ? kWendlandBeta : (dimension == 2 ? 2 : 3);
 }
 } // namespace
 
@@ -370,7 +638,8 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
   const int C = this->NumberOfComponents;
   const Index n = static_cast<Index>(this->Coordinates.size() / 3);
   const double* coords = this->Coordinates.data();
-  rbf.Beta = KernelBeta(D);
+  rbf.Beta = KernelBeta(D, this->Opts.RBFKernel);
+  const bool wendland = rbf.Beta == kWendlandBeta;
   rbf.Global = this->RBFIsGlobal();
   this->Rep.MergedPoints = 0;
   this->Rep.Regularized = 0;
@@ -464,7 +733,17 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
       }
       largest2 = std::max(largest2, r2);
     }
-    const double scale = largest2 > 0.0 && std::isfinite(largest2) ? std::sqrt(largest2) : 1.0;
+    double scale = largest2 > 0.0 && std::isfinite(largest2) ? std::sqrt(largest2) : 1.0;
+    if (wendland)
+    {
+      // Coordinates in units of the support radius rho: SupportRadius, else SupportFactor x the cover radius
+      // of the RBF-PU lattice (a ball holding about PatchPoints points).
+      double umin[3], spacing = 1.0, cover = 1.0;
+      Index counts[3];
+      this->PULattice(umin, spacing, cover, counts);
+      const double rho = this->Opts.SupportRadius > 0.0 ? this->Opts.SupportRadius : this->Opts.SupportFactor * cover;
+      scale = rho > 0.0 && std::isfinite(rho) ? rho : scale;
+    }
     PolyharmonicFit fit;
     std::copy(centre, centre + 3, fit.Origin);
     fit.InvScale = 1.0 / scale;
@@ -485,11 +764,20 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
     rbf.W.assign(static_cast<size_t>(nk) * C, 0.0);
     rbf.Tail.assign(tailStride, 0.0);
     const double lambda = this->Opts.Smoothing * std::pow(fit.InvScale, rbf.Beta);
+    std::vector<double> loo(this->RBFLeaveOneOut ? static_cast<size_t>(nk) * C : 0);
     if (!SolvePolyharmonic(D, rbf.Beta, this->Opts.TailDegree, lambda, rbf.X.data(), nk, f.data(), C, rbf.W.data(),
-          rbf.Tail.data(), fit))
+          rbf.Tail.data(), fit, this->RBFLeaveOneOut ? loo.data() : nullptr))
     {
       this->Err = "the global RBF system has no finite solution";
       return false;
+    }
+    if (this->RBFLeaveOneOut)
+    {
+      rbf.LeaveOneOut.assign(static_cast<size_t>(n) * C, std::numeric_limits<double>::quiet_NaN());
+      for (Index j = 0; j < nk; ++j)
+      {
+        std::copy_n(&loo[static_cast<size_t>(j) * C], C, &rbf.LeaveOneOut[static_cast<size_t>(kept[j]) * C]);
+      }
     }
     this->Rep.Regularized = fit.Regularized ? 1 : 0;
     this->Rep.DegreeUsed = fit.Degree;
@@ -604,24 +892,22 @@ bool Approximator::PrepareRBFFits(const double* xyz, Index count)
 Approximator::PointResult Approximator::RBFPoint(
   const double x[3], FitScratch& s, const ApproximationOutput& out, Index i) const
 {
-  PointResult result{ false, 0, 0.0, false, false };
   const RBFData& rbf = *this->RBFFits;
   const int D = this->Frame.Dimension;
   const int C = this->NumberOfComponents;
-  const bool gradient = out.Gradients != nullptr;
   const size_t tailStride = static_cast<size_t>(kMaxBasisSize) * C;
-  // Work: blended values (C), blended local gradients (3C), one fit's values (C) and gradients (3C).
-  if (s.Work.size() < 8 * static_cast<size_t>(C) + 8)
-  {
-    s.Work.resize(8 * static_cast<size_t>(C) + 8);
-  }
-  double* sumValues = s.Work.data();
-  double* sumGrad = sumValues + C;
-  double* local = sumGrad + 3 * C;
-  double* localGrad = local + C;
-  bool finite = true;
   if (rbf.Global)
   {
+    PointResult result{ false, 0, 0.0, false, false };
+    const bool gradient = out.Gradients != nullptr;
+    // Work: the fit's values (C) and gradients (3C).
+    if (s.Work.size() < 4 * static_cast<size_t>(C) + 4)
+    {
+      s.Work.resize(4 * static_cast<size_t>(C) + 4);
+    }
+    double* local = s.Work.data();
+    double* localGrad = local + C;
+    bool finite = true;
     const PolyharmonicFit& fit = rbf.Fits[0];
     const double dx[3] = { x[0] - fit.Origin[0], x[1] - fit.Origin[1], x[2] - fit.Origin[2] };
     double xi[3] = { 0, 0, 0 };
@@ -659,69 +945,28 @@ Approximator::PointResult Approximator::RBFPoint(
   }
 
   // RBF-PU: the fits whose node lies within R, blended as PU-WLS blends its fits (3.16-3.21).
-  const double R = rbf.CoverRadius;
-  rbf.CenterGrid.FindWithinRadius(x, R, s.Ids, &s.Dist2);
-  SortById(s, s.Ids.size());
-  std::fill(sumValues, sumValues + 4 * C, 0.0);
-  double sumTheta = 0.0;
-  double sumDTheta[3] = { 0, 0, 0 };
-  double best = 0.0;
-  for (size_t j = 0; j < s.Ids.size(); ++j)
-  {
-    const double theta = this->UnitKernel.ValueSquared(s.Dist2[j] / (R * R));
-    if (!(theta > 0.0))
-    {
-      continue;
-    }
-    const Index c = s.Ids[j];
+  auto fitAt = [&](Index c, const double dx[3], double* values, double* gradients) {
     const PolyharmonicFit& fit = rbf.Fits[c];
-    const double dx[3] = { x[0] - fit.Origin[0], x[1] - fit.Origin[1], x[2] - fit.Origin[2] };
     double xi[3] = { 0, 0, 0 };
     this->Frame.Project<3>(dx, fit.InvScale, xi);
     for (int a = D; a < 3; ++a)
     {
       xi[a] = 0.0;
     }
-    EvaluatePolyharmonic(D, rbf.Beta, fit, rbf.X.data(), rbf.W.data(), &rbf.Tail[tailStride * c], xi, C, local,
-      gradient ? localGrad : nullptr);
-    sumTheta += theta;
-    for (int q = 0; q < C; ++q)
+    EvaluatePolyharmonic(
+      D, rbf.Beta, fit, rbf.X.data(), rbf.W.data(), &rbf.Tail[tailStride * c], xi, C, values, gradients);
+    for (int a = 0; gradients && a < D * C; ++a)
     {
-      sumValues[q] += theta * local[q];
+      gradients[a] *= fit.InvScale; // per unit xi -> per unit length
     }
-    if (gradient)
-    {
-      double r[3] = { 0, 0, 0 }, dTheta[3];
-      this->Frame.Project<3>(dx, 1.0 / R, r);
-      for (int a = D; a < 3; ++a)
-      {
-        r[a] = 0.0;
-      }
-      this->UnitKernel.Gradient(r, dTheta); // per unit r / R
-      for (int a = 0; a < D; ++a)
-      {
-        dTheta[a] /= R;
-        sumDTheta[a] += dTheta[a];
-        for (int q = 0; q < C; ++q)
-        {
-          sumGrad[a * C + q] += dTheta[a] * local[q] + theta * localGrad[a * C + q] * fit.InvScale;
-        }
-      }
-    }
-    if (theta > best)
-    {
-      best = theta;
-      result.Neighbors = static_cast<int>(fit.Count);
-      result.Condition = fit.Condition;
-      result.Lowered = fit.Degree < this->Opts.TailDegree;
-    }
-  }
-  if (!(sumTheta > 0.0))
-  {
-    return result;
-  }
-  result.Valid = this->WriteBlend(i, sumValues, sumGrad, sumDTheta, sumTheta, out);
-  return result;
+  };
+  auto info = [&](Index c, PointResult& r) {
+    const PolyharmonicFit& fit = rbf.Fits[c];
+    r.Neighbors = static_cast<int>(fit.Count);
+    r.Condition = fit.Condition;
+    r.Lowered = fit.Degree < this->Opts.TailDegree;
+  };
+  return this->BlendCentres(x, rbf.CenterGrid, rbf.Centers.data(), rbf.CoverRadius, s, out, i, fitAt, info);
 }
 
 } // namespace meshfree

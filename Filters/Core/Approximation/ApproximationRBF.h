@@ -45,10 +45,15 @@ namespace meshfree
 constexpr int kRBFPatchPoints[4] = { 1, 12, 40, 80 };
 /// A patch keeps at most this many times the patch size (its nearest points).
 constexpr int kRBFPatchCap = 8;
-/// Auto, 2D clouds without smoothing: the global thin-plate spline up to this many valid points, PU-WLS of degree
-/// 3 above (measured: the spline is the most accurate at N = 100 on 8 of Renka & Brown's 10 functions, PU-WLS
-/// within 2x of the best error at a fraction of the time from N = 300 on; the crossover lies in between).
-constexpr Index kAutoRBFPoints2D = 200;
+/// Auto, 2D clouds without smoothing: PU-WLS of degree 3 above this many valid points; up to it, the global
+/// thin-plate spline or PU-WLS of degree 3 by their leave-one-out errors (measured: at N = 100 the spline is the
+/// most accurate on 8 of Renka & Brown's 10 functions, PU-WLS on 2; from N = 300 on PU-WLS is within 2x of the
+/// best error at a fraction of the time; the estimate's cost, a dense system of this many rows, stays a fraction
+/// of PU-WLS's time below it).
+constexpr Index kAutoRBFPoints2D = 150;
+/// Auto, small 2D clouds: the spline is chosen when its leave-one-out error is below PU-WLS's by more than this
+/// factor (it costs several times PU-WLS's time to evaluate: about 4x at 100 points and 10^4 evaluation points).
+constexpr double kAutoRBFMargin = 1.25;
 /// Above this 1-norm condition estimate the Cholesky solution is not trusted (eigen-decomposition instead).
 constexpr double kRBFMaxCondition = 1e14;
 
@@ -67,7 +72,7 @@ struct PolyharmonicFit
 struct Approximator::RBFData
 {
   bool Global = true;
-  int Beta = 2;                     // 2: r^2 log r, 3: r^3
+  int Beta = 2;                     // 2: r^2 log r, 3: r^3, kWendlandBeta: Wendland's C2
   std::vector<double> X;            // 3 per centre: its local coordinates in its fit's frame
   std::vector<double> W;            // C per centre
   std::vector<double> Tail;         // kMaxBasisSize * C per fit (row-major, PolynomialBasis order)
@@ -79,6 +84,9 @@ struct Approximator::RBFData
   // Duplicates: whether each point (by original id) is kept, and the values the fits use (merged means).
   std::vector<unsigned char> Kept;
   std::vector<double> Values;
+  // Approximator::RBFLeaveOneOut: the global fit's leave-one-out residuals by point id (n x C; NaN for merged
+  // points or when not defined).
+  std::vector<double> LeaveOneOut;
 };
 
 /**
@@ -120,17 +128,36 @@ inline double KernelLog(double x)
   return e * 0.69314718055994530942 + 2.0 * s * p;
 }
 
-/// phi(r) from r^2 for beta = 2 (r^2 log r = r^2 log(r^2) / 2) and 3 (r^3); 0 at r = 0.
+/// RBFData::Beta of Wendland's C2 kernel (RBFKernelType::WendlandC2): phi(r) = (1 - r)^4 (4 r + 1) for r < 1,
+/// 0 beyond, in coordinates scaled by the support radius (the fit's InvScale is 1 / rho). Being positive
+/// definite, its systems need no scaling of the smoothing (beta 0: lambda' = lambda).
+constexpr int kWendlandBeta = 0;
+
+/// phi(r) from r^2 for beta = 2 (r^2 log r = r^2 log(r^2) / 2), 3 (r^3) and kWendlandBeta; r^2 log r and r^3
+/// are 0 at r = 0.
 inline double PolyharmonicValue(int beta, double r2)
 {
+  if (beta == kWendlandBeta)
+  {
+    const double r = std::sqrt(r2);
+    const double t = r < 1.0 ? 1.0 - r : 0.0;
+    return t * t * t * t * (4.0 * r + 1.0);
+  }
   const double r2safe = r2 > 1e-300 ? r2 : 1.0; // log(1) = 0: phi(0) = 0 (and subnormal r^2 counts as 0)
   return beta == 2 ? 0.5 * r2 * KernelLog(r2safe) : r2 * std::sqrt(r2);
 }
 
-/// phi'(r) / r (the gradient is this times xi - xi_j): log(r^2) + 1 for beta = 2, 3 r for beta = 3; 0 at r = 0
-/// (where xi - xi_j = 0).
+/// phi'(r) / r (the gradient is this times xi - xi_j): log(r^2) + 1 for beta = 2, 3 r for beta = 3,
+/// -20 (1 - r)^3 for Wendland's C2 (0 beyond r = 1); 0 at r = 0 for the polyharmonic kernels (where
+/// xi - xi_j = 0).
 inline double PolyharmonicSlope(int beta, double r2)
 {
+  if (beta == kWendlandBeta)
+  {
+    const double r = std::sqrt(r2);
+    const double t = r < 1.0 ? 1.0 - r : 0.0;
+    return -20.0 * t * t * t;
+  }
   if (!(r2 > 1e-300))
   {
     return 0.0;
@@ -143,9 +170,13 @@ inline double PolyharmonicSlope(int beta, double r2)
  * the first `dimension` used) and values f (n x C, row-major), for a tail of degree <= `degree` and smoothing
  * lambda (in the local coordinates). Writes w (n x C, row-major) and the tail (kMaxBasisSize x C, row-major;
  * the basis of the degree used) and fit.Degree, Condition, Regularized. False when no finite fit exists.
+ * With leaveOneOut (n x C, row-major), lambda = 0 and a Cholesky solve, also the leave-one-out residuals
+ * f_j - s_(j)(xi_j), s_(j) the fit without centre j (same tail degree), by Rippa's formula (Adv. Comput. Math.
+ * 11, 1999): w_j / (A^-1)_jj, A the interpolation system [K P; P^T 0], whose top-left block of the inverse is
+ * Q2 (Q2^T K Q2)^-1 Q2^T in the null-space form above. Otherwise leaveOneOut is filled with NaN.
  */
 bool SolvePolyharmonic(int dimension, int beta, int degree, double lambda, const double* xi, Index n, const double* f,
-  int components, double* w, double* tail, PolyharmonicFit& fit);
+  int components, double* w, double* tail, PolyharmonicFit& fit, double* leaveOneOut = nullptr);
 
 /**
  * Evaluates one fit at the local coordinates xi: out[C] and, when gradient is not null, gradient[a * C + c]
