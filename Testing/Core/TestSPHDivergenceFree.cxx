@@ -8,6 +8,7 @@
 // column's particles keep rearranging at speeds of order sqrt(g dx) (SPHDivergenceFree.cxx, "Known limitation"),
 // so the pressure scatters; it is printed, and only its finiteness and sign are asserted.
 #include "SPH/SPHFluid.h"
+#include "SPHScenes.h"
 
 #include "Common/Parallel.h"
 
@@ -25,37 +26,11 @@ using meshfree::SPHParameters;
 using meshfree::SPHSolver;
 using meshfree::SPHState;
 
+using sphscenes::InsideDomain;
+using sphscenes::SetBox;
+
 namespace
 {
-void SetBox(double* target, std::initializer_list<double> values)
-{
-  int i = 0;
-  for (double v : values)
-  {
-    target[i++] = v;
-  }
-}
-
-bool InsideDomain(const SPHState& s, const SPHParameters& p)
-{
-  for (Index i = 0; i < s.Size(); ++i)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      if (a == 1 && p.Dimension == 2)
-      {
-        continue;
-      }
-      const double x = s.Position[3 * i + a];
-      if (!(x > p.DomainBounds[2 * a] && x < p.DomainBounds[2 * a + 1]))
-      {
-        return false;
-      }
-    }
-  }
-  return true;
-}
-
 struct ColumnResult
 {
   double PressureL2 = 0.0;
@@ -289,18 +264,6 @@ TEST(SPHDivergenceFree, HostileSettings)
   }
 }
 
-namespace dambreak
-{
-// Martin & Moyce 1952, Table 2 (n^2 = 2).
-const double TableT[] = { 0.41, 0.84, 1.19, 1.43, 1.63, 1.83, 1.98, 2.20, 2.32, 2.51, 2.65, 2.83, 2.98, 3.11,
-  3.33 };
-const double TableZ[] = { 1.11, 1.22, 1.44, 1.67, 1.89, 2.11, 2.33, 2.56, 2.78, 3.00, 3.22, 3.44, 3.67, 3.89,
-  4.11 };
-constexpr int TableSize = 15;
-}
-
-using namespace dambreak;
-
 // The 2D dam break of TestSPHDamBreak.cxx (same scene, front definition and Lethe's 0.175 time-origin correction)
 // with DFSPH. Measured (a / dx = 40, 727 steps against WCSPH's ~3,000): corrected time origin within 10 % of
 // Martin & Moyce for 1.43 <= T <= 3.33 (at most 9.8 %, from T = 2.32 on within 1.7 %), but +8.1 % at T = 0.84 and
@@ -308,79 +271,15 @@ using namespace dambreak;
 // time origin within 10 % for T >= 2.32 (at most 9.3 %), and an early lead of 12-23 % (guarded at 25 %).
 TEST(SPHDivergenceFree, DamBreakFrontAgainstMartinMoyce)
 {
-  const double a = 0.1, dx = a / 40.0, g = 9.81;
-  SPHParameters p;
-  p.Dimension = 2;
-  p.ParticleSpacing = dx;
-  p.Viscosity = 1e-3;
-  p.ArtificialViscosity = 0.05; // see the header
-  p.Solver = meshfree::SPHSolver::DFSPH;
-  const double fluid[6] = { 0.0, a, 0.0, 0.0, 0.0, 2.0 * a };
-  const double domain[6] = { 0.0, 5.0 * a, 0.0, 0.0, 0.0, 2.5 * a };
-  std::copy(fluid, fluid + 6, p.FluidBounds);
-  std::copy(domain, domain + 6, p.DomainBounds);
-  SPHFluid solver;
-  solver.Setup(p);
-  SPHState s = solver.InitialState();
-  ASSERT_EQ(s.Size(), 40 * 80);
-
-  const double scale = std::sqrt(2.0 * g / a);
-  const double gateEnd = 2.3; // the raw time origin meets 10 % from here on (see the header)
-  const double origin = 0.175; // Lethe's time-origin correction (see the header)
-
-  // The times the state is needed at, in order: T - origin (corrected) and T (raw) for every tabulated T.
-  struct Probe
+  using namespace sphscenes;
+  DamBreakFronts fronts;
+  ASSERT_NO_FATAL_FAILURE(RunMartinMoyceDamBreak(SPHSolver::DFSPH, fronts));
+  const double gateEnd = 2.3; // the raw time origin meets 10 % from here on (TestSPHDamBreak.cxx)
+  for (int k = 1; k < MartinMoyceSize; ++k)
   {
-    double T;
-    int Row;
-    bool Raw;
-  };
-  std::vector<Probe> probes;
-  for (int k = 1; k < TableSize; ++k) // 0.84 <= T <= 3.33
-  {
-    probes.push_back({ TableT[k] - origin, k, false });
-    probes.push_back({ TableT[k], k, true });
-  }
-  std::stable_sort(probes.begin(), probes.end(), [](const Probe& l, const Probe& r) { return l.T < r.T; });
-
-  std::vector<double> rawZ(TableSize, 0.0), correctedZ(TableSize, 0.0);
-  double previousT = 0.0, previousZ = 1.0;
-  for (const Probe& probe : probes)
-  {
-    ASSERT_EQ(solver.Advance(s, probe.T / scale), SPHFluid::Status::Ok) << solver.ErrorMessage();
-    const std::vector<int> neighbours = solver.NeighborCounts(s);
-    double front = 0.0;
-    for (Index i = 0; i < s.Size(); ++i)
-    {
-      const double x = s.Position[3 * i], z = s.Position[3 * i + 2];
-      if (z - domain[4] < 1.5 * dx && neighbours[i] >= 3)
-      {
-        front = std::max(front, x);
-      }
-    }
-    const double z = (front + 0.5 * dx) / a;
-    (probe.Raw ? rawZ : correctedZ)[probe.Row] = z;
-    EXPECT_LE((z - previousZ) / (probe.T - previousT), 2.0) << "faster than the Ritter front at T = " << probe.T;
-    previousT = probe.T;
-    previousZ = z;
-    ASSERT_TRUE(SPHFluid::Statistics(s, solver.ParticleMass()).Finite);
-    for (Index i = 0; i < s.Size(); ++i)
-    {
-      ASSERT_GT(s.Position[3 * i], domain[0]);
-      ASSERT_LT(s.Position[3 * i], domain[1]);
-      ASSERT_GT(s.Position[3 * i + 2], domain[4]);
-      ASSERT_LT(s.Position[3 * i + 2], domain[5]);
-    }
-  }
-
-  std::printf("   T   Z(M&M) | Z(SPH, T-0.175) error  | Z(SPH, T) error (raw origin)\n");
-  for (int k = 1; k < TableSize; ++k)
-  {
-    const double T = TableT[k];
-    const double corrected = correctedZ[k] / TableZ[k] - 1.0;
-    const double raw = rawZ[k] / TableZ[k] - 1.0;
-    std::printf("%5.2f  %5.2f  |  %6.3f         %+5.1f %% |  %6.3f  %+5.1f %%\n", T, TableZ[k], correctedZ[k],
-      100.0 * corrected, rawZ[k], 100.0 * raw);
+    const double T = MartinMoyceT[k];
+    const double corrected = fronts.Corrected[k] / MartinMoyceZ[k] - 1.0;
+    const double raw = fronts.Raw[k] / MartinMoyceZ[k] - 1.0;
     EXPECT_LE(std::fabs(corrected), T >= 1.4 ? 0.10 : 0.125) << "corrected time origin, T = " << T;
     if (T >= gateEnd)
     {
@@ -392,6 +291,5 @@ TEST(SPHDivergenceFree, DamBreakFrontAgainstMartinMoyce)
       EXPECT_LE(raw, 0.25) << "raw early lead grew beyond its measured level, T = " << T;
     }
   }
-  EXPECT_EQ(s.Size(), 40 * 80);
-  std::printf("%ld steps\n", s.Steps);
+  EXPECT_EQ(fronts.Particles, 40 * 80);
 }

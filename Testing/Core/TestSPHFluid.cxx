@@ -1,6 +1,7 @@
 // SPH fluid core (SPHFluid.h): kernels and lattice consistency, conservation, determinism, hostile settings and
 // the settled hydrostatic column (pressure against rho0 g (H - z)).
 #include "SPH/SPHFluid.h"
+#include "SPHScenes.h"
 
 #include <gtest/gtest.h>
 
@@ -17,37 +18,11 @@ using meshfree::SPHKernelPair;
 using meshfree::SPHParameters;
 using meshfree::SPHState;
 
+using sphscenes::InsideDomain;
+using sphscenes::SetBox;
+
 namespace
 {
-void SetBox(double* target, std::initializer_list<double> values)
-{
-  int i = 0;
-  for (double v : values)
-  {
-    target[i++] = v;
-  }
-}
-
-bool InsideDomain(const SPHState& s, const SPHParameters& p)
-{
-  for (Index i = 0; i < s.Size(); ++i)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      if (a == 1 && p.Dimension == 2)
-      {
-        continue;
-      }
-      const double x = s.Position[3 * i + a];
-      if (!(x > p.DomainBounds[2 * a] && x < p.DomainBounds[2 * a + 1]))
-      {
-        return false;
-      }
-    }
-  }
-  return true;
-}
-
 // A small block in free space (no walls, no gravity) with random velocities.
 SPHParameters FreeBlock(int dimension, SPHKernelPair kernels)
 {
