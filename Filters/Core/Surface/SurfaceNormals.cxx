@@ -2,6 +2,8 @@
 // PCA normals over a density- and noise-adapted neighbourhood (SurfaceNormals.h).
 #include "Surface/SurfaceNormals.h"
 
+#include "Surface/AdaptiveJet.h"
+
 #include "Common/LocalFit.h"
 #include "Common/Parallel.h"
 #include "Common/Statistics.h"
@@ -18,6 +20,10 @@ namespace meshfree
 namespace
 {
 constexpr double Pi = 3.141592653589793238462643383279502884;
+// The adaptive jet's radii (AdaptiveJet.h): from SmallestScale x r_k (about 12 neighbours at k = 20) up to
+// TopScale x max(r_k, the noise radius).
+constexpr double SmallestScale = 0.8;
+constexpr double TopScale = 2.5;
 
 struct LocalPCA
 {
@@ -363,11 +369,14 @@ bool EstimateNormals(
   }
   const double noiseRadius = field.Scale.Radius;
   const int k = std::max(std::max(3, options.NeighborCount), degree);
-  // Where the density sets the radius: one query a little wider than the typical r_k usually holds the k
-  // nearest, which saves the k-nearest search (a third of the normals' time on noise-free clouds).
-  const double densityRadius = fixed || noiseRadius > 0.0
-    ? 0.0
-    : 1.1 * field.Scale.Spacing / std::sqrt(Pi / std::max(3, options.NeighborCount));
+  const bool adaptive = !fixed && options.AdaptToNoise && options.Confidence > 0.0;
+  // One query a little wider than the typical radius usually holds the k nearest, which saves the k-nearest
+  // search (a third of the normals' time on noise-free clouds).
+  const double typical = field.Scale.Spacing / std::sqrt(Pi / std::max(3, options.NeighborCount));
+  const double first = fixed ? options.SupportRadius
+    : adaptive               ? 1.1 * TopScale * std::max(typical, noiseRadius)
+    : noiseRadius > 0.0      ? noiseRadius
+                             : 1.1 * typical;
   const double* sorted = grid.SortedPoints();
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
@@ -378,6 +387,7 @@ bool EstimateNormals(
   {
     std::vector<Index> Ids, Positions;
     std::vector<double> Dist2, Radius2, Keys;
+    AdaptiveJetScratch Jet;
   };
   PerThread<Buffers> buffers;
   for (Index begin = 0; begin < nv && !aborted; begin += chunk)
@@ -397,14 +407,13 @@ bool EstimateNormals(
           const Index id = order[s];
           const double* x = sorted + 3 * s;
           std::int32_t* row = &field.Graph[static_cast<size_t>(id) * degree];
-          // Where the noise (or density) radius holds more than k neighbours, the k nearest are among them: one
-          // radius query gives the neighbourhood, r_k and the orientation graph. Otherwise a k-nearest query.
-          const double first = fixed ? options.SupportRadius : noiseRadius > 0.0 ? noiseRadius : densityRadius;
+          // One radius query, wide enough for every radius the point may need, usually holds its k nearest too:
+          // it gives r_k, the orientation graph and the neighbourhood. Otherwise a k-nearest query first.
           if (first > 0.0)
           {
             grid.FindWithinRadiusPositions(x, first, pos, r2);
           }
-          double radius = first;
+          double queried = first;
           if (!(first > 0.0 && NearestOfList(pos, r2, k, order, row, degree, field.NeighborDistance[id], keys)))
           {
             const int found = NearestDistinct(grid, x, k, ids, d2, field.NeighborDistance[id]);
@@ -416,16 +425,20 @@ bool EstimateNormals(
                 row[kept++] = static_cast<std::int32_t>(ids[j]);
               }
             }
-            if (!fixed)
-            {
-              radius = std::max(field.NeighborDistance[id], noiseRadius);
-              grid.FindWithinRadiusPositions(x, radius, pos, r2);
-            }
+            queried = 0.0;
           }
-          else if (densityRadius > 0.0)
+          const double rk = field.NeighborDistance[id];
+          // The radius this point needs: fixed; r_k (no adaptation); or the adaptive jet's largest radius.
+          const double radius = fixed ? options.SupportRadius
+            : adaptive                 ? TopScale * std::max(rk, noiseRadius)
+                                       : std::max(rk, noiseRadius);
+          if (queried < radius)
           {
-            // The neighbourhood is the points within r_k, as a query at r_k would give them.
-            radius = field.NeighborDistance[id];
+            grid.FindWithinRadiusPositions(x, radius, pos, r2);
+          }
+          else if (queried > radius)
+          {
+            // The neighbourhood is the points within the radius, as a query at it would give them.
             const double cut = radius * radius;
             size_t kept = 0;
             for (size_t j = 0; j < pos.size(); ++j)
@@ -439,9 +452,29 @@ bool EstimateNormals(
             pos.resize(kept);
             r2.resize(kept);
           }
-          // Where the noise sets the radius, the quadric's exactness is below the noise's tilt: PCA suffices.
-          const bool jet = fixed || !(noiseRadius > field.NeighborDistance[id]);
-          const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius, jet);
+          LocalPCA pca;
+          double used = radius;
+          if (adaptive)
+          {
+            AdaptiveJetOptions jet;
+            jet.Noise = field.Scale.Noise;
+            jet.Gamma = options.Confidence;
+            jet.FrameRadius = std::max(rk, noiseRadius);
+            jet.SmallestRadius = SmallestScale * rk;
+            jet.LargestRadius = radius;
+            const AdaptiveJetResult a = AdaptiveJetNormal(sorted, pos, r2, x, jet, mine.Jet);
+            std::copy(a.Normal, a.Normal + 3, pca.Normal);
+            std::copy(a.Eigenvalues, a.Eigenvalues + 3, pca.Eigenvalues);
+            pca.Residual = a.Residual;
+            pca.Valid = a.Valid;
+            used = a.Radius;
+          }
+          else
+          {
+            // Where the noise sets the radius, the quadric's exactness is below the noise's tilt: PCA suffices.
+            const bool jet = fixed || !(noiseRadius > rk);
+            pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius, jet);
+          }
           if (!pca.Valid)
           {
             ++failed;
@@ -454,7 +487,7 @@ bool EstimateNormals(
           field.Residual[id] = pca.Residual;
           const double total = pca.Eigenvalues[0] + pca.Eigenvalues[1] + pca.Eigenvalues[2];
           field.SurfaceVariation[id] = total > 0.0 ? pca.Eigenvalues[0] / total : 0.0;
-          field.Radii[id] = radius;
+          field.Radii[id] = used;
           field.Valid[id] = 1;
         }
         return failed;

@@ -45,6 +45,7 @@ struct NormalOptions
   double SupportRadius = 0.0;   // > 0: one fixed radius for every point (no adaptation)
   bool AdaptToNoise = true;     // widen the radius until the noise tilts normals by < TiltTolerance
   double TiltTolerance = 0.05;  // radians
+  double Confidence = 2.0;      // adaptive jet radius (AdaptiveJet.h): interval half-width in standard deviations
   int GraphDegree = 8;          // nearest neighbours kept for the orientation graph
 };
 
