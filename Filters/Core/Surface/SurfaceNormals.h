@@ -45,7 +45,6 @@ struct NormalOptions
   double SupportRadius = 0.0;   // > 0: one fixed radius for every point (no adaptation)
   bool AdaptToNoise = true;     // widen the radius until the noise tilts normals by < TiltTolerance
   double TiltTolerance = 0.05;  // radians
-  double Confidence = 2.0;      // adaptive jet radius (AdaptiveJet.h): interval half-width in standard deviations
   int GraphDegree = 8;          // nearest neighbours kept for the orientation graph
 };
 
@@ -54,7 +53,10 @@ struct CloudScale
 {
   double Spacing = 0.0; // distance between neighbouring samples on the surface, r_k sqrt(pi / k)
   double Noise = 0.0;   // spread of the points about the surface, sqrt(l0) at the chosen radius
-  double Radius = 0.0;  // the neighbourhood radius the noise asks for (0 when the density decides)
+  double Radius = 0.0;  // the fits' noise radius: noise tilt < TiltTolerance (0 when the density decides)
+  double FitNoise = 0.0;     // the median root mean square misfit of the normals' jets (sigma along the normal)
+  double Curvature = 0.0;    // the median larger principal curvature of the normals' jets
+  double NormalRadius = 0.0; // the normals' jet radius (0 when the density decides), see the file comment
 };
 
 struct NormalField
