@@ -24,6 +24,7 @@ constexpr double NormalTilt = 0.0025;
 constexpr double CurvatureReach = 0.9;
 constexpr double MaxNeighbors = 1000.0;
 constexpr size_t MaxFit = 256;
+constexpr size_t FramePoints = 64; // the jet's frame (its PCA) from this many of them
 // Sharp features (SharpFeatures): a jet misfitting its neighbours by more than FlagMisfit x the noise and
 // FlagFloor x its radius reaches across a crease.
 constexpr double FlagMisfit = 1.25;
@@ -151,12 +152,15 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
   }
   const size_t used = std::min(count, std::max<size_t>(maxFit, 3));
   auto at = [&](size_t m) { return sorted + 3 * pos[used == count ? m : m * count / used]; };
+  // The frame (PCA) from fewer points still: the jet corrects its tilt.
+  const size_t framed = std::min(used, FramePoints);
+  auto frameAt = [&](size_t m) { return sorted + 3 * pos[framed == count ? m : m * count / framed]; };
   const double inv = 1.0 / scale;
   double m1[3] = { 0.0, 0.0, 0.0 };
   double m2[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; // xx, xy, xz, yy, yz, zz
-  for (size_t m = 0; m < used; ++m)
+  for (size_t m = 0; m < framed; ++m)
   {
-    const double* p = at(m);
+    const double* p = frameAt(m);
     const double d0 = (p[0] - x[0]) * inv, d1 = (p[1] - x[1]) * inv, d2 = (p[2] - x[2]) * inv;
     m1[0] += d0;
     m1[1] += d1;
@@ -168,7 +172,7 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
     m2[4] += d1 * d2;
     m2[5] += d2 * d2;
   }
-  const double w = 1.0 / static_cast<double>(used);
+  const double w = 1.0 / static_cast<double>(framed);
   for (double& m : m1)
   {
     m *= w;
@@ -669,6 +673,8 @@ bool EstimateNormals(
   const double typical = field.Scale.Spacing / std::sqrt(Pi / std::max(3, options.NeighborCount));
   const double first = fixed ? options.SupportRadius : std::max(1.1 * typical, normalRadius);
   const double near2 = fixed ? first * first : 1.21 * typical * typical;
+  // The near part of the first list: the k nearest (within near2) and the outliers' neighbourhood.
+  const double nearLimit2 = fixed ? near2 : std::max(near2, field.Scale.Radius * field.Scale.Radius);
   const double* sorted = grid.SortedPoints();
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
@@ -679,8 +685,8 @@ bool EstimateNormals(
   std::vector<double> rms(static_cast<size_t>(nv), 0.0), height(static_cast<size_t>(nv), 0.0);
   struct Buffers
   {
-    std::vector<Index> Ids, Positions, Small;
-    std::vector<double> Dist2, Radius2, Keys;
+    std::vector<Index> Ids, Positions, Small, Local;
+    std::vector<double> Dist2, Radius2, Keys, SmallD2;
   };
   PerThread<Buffers> buffers;
   for (Index begin = 0; begin < nv && !aborted; begin += chunk)
@@ -707,8 +713,19 @@ bool EstimateNormals(
             grid.FindWithinRadiusPositions(x, first, pos, r2);
           }
           double queried = first;
-          if (!(first > 0.0 &&
-                NearestOfList(sorted, pos, r2, near2, k, order, row, degree, field.NeighborDistance[id], keys)))
+          // The near part of the list, once: the k nearest and the outliers' small neighbourhood lie in it.
+          mine.Small.clear();
+          mine.SmallD2.clear();
+          for (size_t j = 0; j < pos.size(); ++j)
+          {
+            if (r2[j] <= nearLimit2)
+            {
+              mine.Small.push_back(pos[j]);
+              mine.SmallD2.push_back(r2[j]);
+            }
+          }
+          if (!(first > 0.0 && NearestOfList(sorted, mine.Small, mine.SmallD2, near2, k, order, row, degree,
+                                 field.NeighborDistance[id], keys)))
           {
             const int found = NearestDistinct(grid, x, k, ids, d2, field.NeighborDistance[id]);
             int kept = 0;
@@ -760,15 +777,18 @@ bool EstimateNormals(
           if (small < radius)
           {
             const double cut = small * small;
-            mine.Small.clear();
-            for (size_t j = 0; j < pos.size(); ++j)
+            const bool inNear = queried > 0.0 && cut <= nearLimit2;
+            const std::vector<Index>& from = inNear ? mine.Small : pos;
+            const std::vector<double>& fromD2 = inNear ? mine.SmallD2 : r2;
+            mine.Local.clear();
+            for (size_t j = 0; j < from.size(); ++j)
             {
-              if (r2[j] <= cut)
+              if (fromD2[j] <= cut)
               {
-                mine.Small.push_back(pos[j]);
+                mine.Local.push_back(from[j]);
               }
             }
-            const JetFit local = FitJet(sorted, mine.Small.data(), mine.Small.size(), x, small, MaxFit);
+            const JetFit local = FitJet(sorted, mine.Local.data(), mine.Local.size(), x, small, MaxFit);
             field.Residual[id] = local.Valid ? local.Residual : fit.Residual;
           }
           const double total = fit.Eigenvalues[0] + fit.Eigenvalues[1] + fit.Eigenvalues[2];
