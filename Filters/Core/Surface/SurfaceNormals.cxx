@@ -365,7 +365,7 @@ void SharpFeatures(
     std::vector<Index> Positions;
     std::vector<double> Dist2;
   };
-  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
+  PerThread<Buffers> buffers;
   // The height of y over sorted position j's tangent plane; its distance to j's jet (the height less the
   // point's own) less the band that still counts as on it.
   auto along = [&](Index j, const double* y) {
@@ -383,7 +383,7 @@ void SharpFeatures(
     return rms[j] > FlagMisfit * noise && rms[j] > FlagFloor * field.Radii[order[j]];
   };
   ParallelFor(nv, 256, [&](Index b0, Index b1) {
-    Buffers& mine = buffers[static_cast<size_t>(ThreadIndex())];
+    Buffers& mine = buffers.Local();
     for (Index s = b0; s < b1; ++s)
     {
       const Index id = order[s];
@@ -505,12 +505,12 @@ void EstimateNormalRadius(const NeighborGrid& grid, const NormalOptions& options
     std::vector<Index> Positions;
     std::vector<double> Dist2;
   };
-  std::vector<Buffers> buffers(static_cast<size_t>(MaxThreads()));
+  PerThread<Buffers> buffers;
   const double cap = scale.Spacing * std::sqrt(MaxNeighbors / Pi);
   double radius = rk;
   auto fitSample = [&]() {
     ParallelFor(samples, 16, [&](Index begin, Index end) {
-      Buffers& mine = buffers[static_cast<size_t>(ThreadIndex())];
+      Buffers& mine = buffers.Local();
       for (Index j = begin; j < end; ++j)
       {
         const double* x = sorted + 3 * (j * nv / samples);
