@@ -22,8 +22,8 @@
  * SupportRadius > 0 replaces all of this with one fixed radius; AdaptToNoise off keeps r_k.
  *
  * Sharp features: a point whose jet misfits its neighbours by more than 1.25 sigma (and 1 % of R) reaches
- * across a crease; it takes the normal of the neighbour (within R) whose jet fits best and passes through the
- * point: the neighbourhood on its side of the crease. Points in the crease itself (no such side) take a jet
+ * across a crease; it takes the normal of the neighbour (within R, and within 0.2 rad / the median curvature)
+ * whose jet fits best and passes through the point: the neighbourhood on its side of the crease. Points in the crease itself (no such side) take a jet
  * over the smallest neighbourhood the noise allows.
  *
  * CloudScale::Noise and ::Radius (the noise radius with TiltTolerance, from the PCA spread) size the implicit
