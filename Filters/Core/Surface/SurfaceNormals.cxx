@@ -30,6 +30,7 @@ constexpr size_t FramePoints = 64; // the jet's frame (its PCA) from this many o
 constexpr double FlagMisfit = 1.25;
 constexpr double FlagFloor = 0.01;
 constexpr double MaxCrossing = 0.2;
+constexpr double NoiseAgreement = 1.5; // the jets' noise at most this many times the PCA spread's (thin parts)
 constexpr double MaxTurn = 0.2; // radians: the most the curvature may turn the normal between a point and its donor
 
 struct LocalPCA
@@ -526,7 +527,10 @@ void EstimateNormalRadius(const NeighborGrid& grid, const NormalOptions& options
         curvature[j] = fit.Valid ? fit.Curvature : 0.0;
       }
     });
-    scale.FitNoise = Median(rms);
+    // The misfit also grows where a neighbourhood takes in two sheets (a part thinner than it): the noise is
+    // at most NoiseAgreement x the PCA spread at the fits' own radius (CloudScale::Noise), which stays small
+    // there; the jets that misfit beyond it then shrink the radius as a crease's do.
+    scale.FitNoise = std::min(Median(rms), NoiseAgreement * scale.Noise);
     scale.Curvature = Median(curvature);
   };
   // The noise's tilt sigma h / (sqrt(pi) R^2) per slope below NormalTilt, the cost at most MaxNeighbors. A
@@ -672,7 +676,9 @@ bool EstimateNormals(
   {
     field.Scale = EstimateCloudScale(grid, options);
   }
-  const double normalRadius = options.AdaptToNoise ? field.Scale.NormalRadius : 0.0;
+  const double normalRadius = !options.AdaptToNoise ? 0.0
+    : options.WideNormals                           ? field.Scale.NormalRadius
+                                                    : field.Scale.Radius;
   const int k = std::max(std::max(3, options.NeighborCount), degree);
   // One query a little wider than the typical radius usually holds the k nearest, which saves the k-nearest
   // search (a third of the normals' time on noise-free clouds).
@@ -811,7 +817,7 @@ bool EstimateNormals(
     aborted = progress && !progress(0.9 * static_cast<double>(end) / static_cast<double>(nv));
   }
   field.InvalidCount = invalid;
-  if (!aborted && !fixed && options.AdaptToNoise)
+  if (!aborted && !fixed && options.AdaptToNoise && options.WideNormals)
   {
     SharpFeatures(grid, field, rms, height);
     aborted = progress && !progress(1.0);

@@ -59,6 +59,8 @@ struct NormalOptions
   int NeighborCount = 20;       // the smallest neighbourhood: this many nearest other points
   double SupportRadius = 0.0;   // > 0: one fixed radius for every point (no adaptation)
   bool AdaptToNoise = true;     // the normals' jets over CloudScale::NormalRadius (else r_k)
+  bool WideNormals = true;      // false: jets over the fits' noise radius (CloudScale::Radius), no crease pass
+                                // (Meshless Surface: wide jets take in both sides of parts thinner than them)
   double TiltTolerance = 0.05;  // radians: the implicit fits' noise radius (CloudScale::Radius)
   int GraphDegree = 8;          // nearest neighbours kept for the orientation graph
 };
