@@ -14,8 +14,10 @@
  * With ProjectPoints on, the points are moved onto the MLS (algebraic point-set) surface, which removes
  * noise along the normal; normals and curvature are then those at the moved points.
  *
- * Normals are the PCA normals (Hoppe et al. 1992) over a neighbourhood of at least NeighborCount points,
- * widened where the cloud's noise asks for it (SupportRadius > 0 fixes the radius). Orientation:
+ * Normals are degree-2 jet normals (Cazals & Pouget 2005) over a neighbourhood of at least NeighborCount
+ * points, widened where the cloud's noise asks for it and kept within the curvature and away from creases
+ * (a point whose neighbourhood reaches across an edge takes the normal of the neighbourhood on its side;
+ * Core/Surface/SurfaceNormals.h). SupportRadius > 0 fixes the radius. Orientation:
  * - Auto (default): like InputNormals when the input has a 3-component point array `Normals`, else Propagation;
  * - Propagation: a minimum spanning tree over the neighbour graph, each connected piece then turned outward;
  * - Viewpoint: as Propagation, each piece then turned towards Viewpoint (a scanner's position);

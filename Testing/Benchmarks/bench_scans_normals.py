@@ -4,11 +4,13 @@ and p99 in degrees; share consistently oriented; share outward).
 
     pvpython --no-mpi Testing/Benchmarks/bench_scans_normals.py [--points 150000] [--virtual DIR]
         [--levels 0,0.00125,0.006,0.012] [--shapes torus,sphere,cube] [--out DIR] [--work DIR] [--timeout 600]
+        [--no-issue-torus]
 
 Clouds: the torus R = 1, r = 0.35, the unit sphere and the cube [-1, 1]^3, --points uniform by area, Gaussian
 noise per axis of sigma = level x the bounding-box diagonal (PCPNet's levels: 0, 0.125 %, 0.6 %, 1.2 %), the true
 normal being the noise-free point's (the cube: its face's; edges and corners are where estimators smear); plus
-each virtual scan of --virtual (virtual_scan.py; true normals in its .npz).
+each virtual scan of --virtual (virtual_scan.py; true normals in its .npz); plus issue 23's torus (150,000 points,
+sigma = 0.002; PCA k 80 beside it) unless --no-issue-torus.
 Estimators, each in its own process (wall time and peak memory by /usr/bin/time -v):
   MeshFree      MeshlessNormals with its defaults (surface_run_meshfree.py normals): oriented
   PCA k         k = 18, 112, 450 nearest neighbours, smallest-eigenvector of the covariance (numpy/scipy,
@@ -113,6 +115,8 @@ def main():
     ap.add_argument("--work", default=os.path.join(os.environ.get("TMPDIR", "/tmp"), "meshfree-bench-normals"))
     ap.add_argument("--timeout", type=int, default=600)
     ap.add_argument("--seed", type=int, default=3)
+    ap.add_argument("--no-issue-torus", dest="issue_torus", action="store_false",
+                    help="leave out issue 23's torus (150k points, sigma 0.002, PCA k 80 beside it)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     os.makedirs(a.work, exist_ok=True)
@@ -127,6 +131,11 @@ def main():
         for level in [float(v) for v in a.levels.split(",")]:
             p = base_p + rng.normal(size=base_p.shape) * level * diag
             clouds.append(("%s, noise %.3g %%" % (shape, 100 * level), p, base_n))
+    if a.issue_torus:
+        # Issue 23's own cloud: the torus at 150,000 points, sigma = 0.002 per axis (PCA k 80 beside it).
+        base_p, base_n = torus(150000, np.random.default_rng(a.seed + 1))
+        clouds.append(("torus 150k, sigma 0.002 (issue 23)",
+                       base_p + np.random.default_rng(a.seed + 2).normal(size=base_p.shape) * 0.002, base_n))
     if a.virtual:
         for name in sorted(os.listdir(a.virtual)):
             if name.startswith("vscan_") and name.endswith(".npz"):
@@ -167,7 +176,7 @@ def main():
                 mp, mn = read_vtp_normals(stem + "_mf.vtp")
                 ok = len(mp) == len(pts)
             add("MeshFree Meshless Normals", mn if ok else None, run, why=str(info.get("error", ""))[:200])
-        for k in PCA_K:
+        for k in PCA_K + ((80,) if "issue 23" in label else ()):
             import time
             t0, load = time.perf_counter(), loadavg()[0]
             n = pca_normals(pts, min(k, len(pts)))

@@ -6,9 +6,11 @@
 // permutation) in the same order, and the approximation (LS, WLS, MLS, PU-WLS, SPH with volumes from the number
 // density and from given volumes; k nearest and fixed radius; values, gradients, masks, neighbour counts) gives the
 // same bits. Ties are broken by position: at a lattice cell's centre the nearest of its 8 equidistant corners is
-// the one with the smallest (x, y, z), whatever the order.
+// the one with the smallest (x, y, z), whatever the order. Meshless Normals' core (CloudNormals.h: the jets, their
+// radius, the sharp-feature pass, the orientation graph and its spanning tree, curvature) gives the same bits too.
 #include "Approximation/Approximation.h"
 #include "Common/NeighborGrid.h"
+#include "Surface/CloudNormals.h"
 #include "Surface/SurfaceReconstruction.h"
 #include "SurfaceSamples.h"
 
@@ -482,4 +484,51 @@ TEST(OrderIndependence, SurfaceOfAPermutedCloudHasTheSameTriangles)
     }
   }
   EXPECT_EQ(compared, (2 * 3 + 2) * 3);
+}
+
+TEST(OrderIndependence, NormalsOfAPermutedCloudAreBitwiseEqual)
+{
+  // A torus sampled on a (u, v) lattice (every point has pairs of equidistant neighbours: the k-th nearest and
+  // the orientation graph's rows are decided by ties), a noisy random torus (the noise-adapted jets) and a noisy
+  // cube (the sharp-feature pass).
+  std::vector<Cloud> clouds(3);
+  for (int i = 0; i < 120; ++i)
+  {
+    for (int j = 0; j < 40; ++j)
+    {
+      const double u = 2.0 * M_PI * i / 120.0, v = 2.0 * M_PI * j / 40.0, ring = 1.0 + 0.35 * std::cos(v);
+      clouds[0].insert(clouds[0].end(), { ring * std::cos(u), ring * std::sin(u), 0.35 * std::sin(v) });
+    }
+  }
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (int i = 0; i < 6000; ++i)
+  {
+    const double u = 2.0 * M_PI * u01(rng), v = 2.0 * M_PI * u01(rng), ring = 1.0 + 0.35 * std::cos(v);
+    clouds[1].insert(clouds[1].end(),
+      { ring * std::cos(u) + 0.005 * g(rng), ring * std::sin(u) + 0.005 * g(rng), 0.35 * std::sin(v) + 0.005 * g(rng) });
+    double p[3] = { 2.0 * u01(rng) - 1.0, 2.0 * u01(rng) - 1.0, 2.0 * u01(rng) - 1.0 };
+    p[i % 3] = i % 2 ? 1.0 : -1.0;
+    clouds[2].insert(clouds[2].end(), { p[0] + 0.005 * g(rng), p[1] + 0.005 * g(rng), p[2] + 0.005 * g(rng) });
+  }
+  const char* names[] = { "lattice torus", "noisy torus", "noisy cube" };
+  for (int c = 0; c < 3; ++c)
+  {
+    const Cloud& cloud = clouds[c];
+    CloudNormalsResult want;
+    ASSERT_TRUE(ComputeCloudNormals(cloud.data(), Count(cloud), nullptr, CloudNormalsOptions(), want));
+    EXPECT_EQ(want.Invalid, 0) << names[c];
+    for (unsigned seed : { 1u, 2u, 3u })
+    {
+      const std::vector<Index> perm = Permutation(Count(cloud), seed);
+      const Cloud permuted = Permute(cloud, perm, 3);
+      CloudNormalsResult got;
+      ASSERT_TRUE(ComputeCloudNormals(permuted.data(), Count(permuted), nullptr, CloudNormalsOptions(), got));
+      EXPECT_TRUE(SameBits(got.Normals, Permute(want.Normals, perm, 3))) << names[c] << ", permutation " << seed;
+      EXPECT_TRUE(SameBits(got.Curvature, Permute(want.Curvature, perm, 1))) << names[c] << ", permutation " << seed;
+      EXPECT_TRUE(SameBits(got.Radius, Permute(want.Radius, perm, 1))) << names[c] << ", permutation " << seed;
+      EXPECT_TRUE(SameBits(got.Confidence, Permute(want.Confidence, perm, 1))) << names[c] << ", permutation " << seed;
+    }
+  }
 }

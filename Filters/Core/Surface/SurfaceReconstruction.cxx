@@ -370,6 +370,7 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     NormalOptions no;
     no.NeighborCount = options.NeighborCount;
     no.SupportRadius = options.SupportRadius;
+    no.WideNormals = false; // the fits' own radius: wide jets take in both sides of thin parts
     if (!EstimateNormals(grid, no, normals, Stage(progress, 0.0, 0.15)) && progress && !progress(0.15))
     {
       report.Aborted = true;
