@@ -65,22 +65,19 @@ int NearestDistinct(const NeighborGrid& grid, const double x[3], int k, std::vec
   }
 }
 
-/// PCA of the points at sorted positions pos[0..count) of `sorted`, about their centroid, in coordinates
-/// shifted to x and scaled by 1/scale (the noise estimate of the fits' radius, CloudScale::Radius).
-LocalPCA PrincipalAxes(const double* sorted, const Index* pos, size_t count, const double x[3], double scale)
+/// The mean offset (mean[3]) and the covariance's eigen-decomposition of `count` points given by point(m), in
+/// coordinates shifted to x and scaled by inv (|d| <= 1): one pass of first and second moments,
+/// C = E[d d^T] - E[d] E[d]^T. False when the points span no plane (collinear or coincident: the closed-form
+/// solver's eigenvalues are accurate to ~1e-9 of the largest, so a relative width below 1e-3 counts as a line).
+template <class Point>
+bool ScaledCovariance(size_t count, const Point& point, const double x[3], double inv, double mean[3],
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig)
 {
-  LocalPCA out;
-  if (count < 3 || !(scale > 0.0))
-  {
-    return out;
-  }
-  // One pass: first and second moments in the scaled coordinates (|d| <= 1), C = E[d d^T] - E[d] E[d]^T.
-  const double inv = 1.0 / scale;
   double m1[3] = { 0.0, 0.0, 0.0 };
   double m2[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; // xx, xy, xz, yy, yz, zz
-  for (size_t j = 0; j < count; ++j)
+  for (size_t m = 0; m < count; ++m)
   {
-    const double* p = sorted + 3 * pos[j];
+    const double* p = point(m);
     const double d0 = (p[0] - x[0]) * inv, d1 = (p[1] - x[1]) * inv, d2 = (p[2] - x[2]) * inv;
     m1[0] += d0;
     m1[1] += d1;
@@ -93,26 +90,39 @@ LocalPCA PrincipalAxes(const double* sorted, const Index* pos, size_t count, con
     m2[5] += d2 * d2;
   }
   const double w = 1.0 / static_cast<double>(count);
-  for (double& m : m1)
+  for (int a = 0; a < 3; ++a)
   {
-    m *= w;
+    mean[a] = m1[a] * w;
   }
   Eigen::Matrix3d C;
-  C(0, 0) = m2[0] * w - m1[0] * m1[0];
-  C(0, 1) = C(1, 0) = m2[1] * w - m1[0] * m1[1];
-  C(0, 2) = C(2, 0) = m2[2] * w - m1[0] * m1[2];
-  C(1, 1) = m2[3] * w - m1[1] * m1[1];
-  C(1, 2) = C(2, 1) = m2[4] * w - m1[1] * m1[2];
-  C(2, 2) = m2[5] * w - m1[2] * m1[2];
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  C(0, 0) = m2[0] * w - mean[0] * mean[0];
+  C(0, 1) = C(1, 0) = m2[1] * w - mean[0] * mean[1];
+  C(0, 2) = C(2, 0) = m2[2] * w - mean[0] * mean[2];
+  C(1, 1) = m2[3] * w - mean[1] * mean[1];
+  C(1, 2) = C(2, 1) = m2[4] * w - mean[1] * mean[2];
+  C(2, 2) = m2[5] * w - mean[2] * mean[2];
   eig.computeDirect(C);
   const Eigen::Vector3d l = eig.eigenvalues();
-  // Collinear or coincident neighbours leave the plane undetermined. (The closed-form solver's eigenvalues
-  // are accurate to ~1e-9 of the largest, so a relative width below 1e-3 counts as a line.)
-  if (!(l(1) > 1e-6 * l(2)) || !(l(2) > 0.0) || !std::isfinite(l(2)))
+  return l(1) > 1e-6 * l(2) && l(2) > 0.0 && std::isfinite(l(2));
+}
+
+/// PCA of the points at sorted positions pos[0..count) of `sorted`, about their centroid, in coordinates
+/// shifted to x and scaled by 1/scale (the noise estimate of the fits' radius, CloudScale::Radius).
+LocalPCA PrincipalAxes(const double* sorted, const Index* pos, size_t count, const double x[3], double scale)
+{
+  LocalPCA out;
+  if (count < 3 || !(scale > 0.0))
   {
     return out;
   }
+  const double inv = 1.0 / scale;
+  double m1[3];
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  if (!ScaledCovariance(count, [&](size_t j) { return sorted + 3 * pos[j]; }, x, inv, m1, eig))
+  {
+    return out;
+  }
+  const Eigen::Vector3d l = eig.eigenvalues();
   Eigen::Vector3d n = eig.eigenvectors().col(0).normalized();
   // The distance from the point to the plane through the centroid.
   out.Residual = std::fabs(n(0) * m1[0] + n(1) * m1[1] + n(2) * m1[2]) * scale;
@@ -158,41 +168,13 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
   const size_t framed = std::min(used, FramePoints);
   auto frameAt = [&](size_t m) { return sorted + 3 * pos[framed == count ? m : m * count / framed]; };
   const double inv = 1.0 / scale;
-  double m1[3] = { 0.0, 0.0, 0.0 };
-  double m2[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; // xx, xy, xz, yy, yz, zz
-  for (size_t m = 0; m < framed; ++m)
-  {
-    const double* p = frameAt(m);
-    const double d0 = (p[0] - x[0]) * inv, d1 = (p[1] - x[1]) * inv, d2 = (p[2] - x[2]) * inv;
-    m1[0] += d0;
-    m1[1] += d1;
-    m1[2] += d2;
-    m2[0] += d0 * d0;
-    m2[1] += d0 * d1;
-    m2[2] += d0 * d2;
-    m2[3] += d1 * d1;
-    m2[4] += d1 * d2;
-    m2[5] += d2 * d2;
-  }
-  const double w = 1.0 / static_cast<double>(framed);
-  for (double& m : m1)
-  {
-    m *= w;
-  }
-  Eigen::Matrix3d C;
-  C(0, 0) = m2[0] * w - m1[0] * m1[0];
-  C(0, 1) = C(1, 0) = m2[1] * w - m1[0] * m1[1];
-  C(0, 2) = C(2, 0) = m2[2] * w - m1[0] * m1[2];
-  C(1, 1) = m2[3] * w - m1[1] * m1[1];
-  C(1, 2) = C(2, 1) = m2[4] * w - m1[1] * m1[2];
-  C(2, 2) = m2[5] * w - m1[2] * m1[2];
+  double m1[3];
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  eig.computeDirect(C);
-  const Eigen::Vector3d l = eig.eigenvalues();
-  if (!(l(1) > 1e-6 * l(2)) || !(l(2) > 0.0) || !std::isfinite(l(2)))
+  if (!ScaledCovariance(framed, frameAt, x, inv, m1, eig))
   {
     return out; // collinear or coincident: no plane
   }
+  const Eigen::Vector3d l = eig.eigenvalues();
   Eigen::Vector3d n = eig.eigenvectors().col(0).normalized();
   const Eigen::Vector3d t1 = eig.eigenvectors().col(2).normalized();
   const Eigen::Vector3d t2 = n.cross(t1);
