@@ -60,10 +60,25 @@ self.GetOutputInformation(0).Set(vtkAlgorithm.CAN_HANDLE_PIECE_REQUEST(), 1)
 """
 
 
-def worker(args):
-    import resource
-    import time
+def find_plugin(plugin):
+    """The MeshFree.so to load: `plugin` when given, else the one under build/; exits when there is none."""
+    if plugin is None:
+        here = os.path.dirname(os.path.abspath(__file__))
+        found = glob.glob(os.path.join(here, "..", "..", "build", "**", "MeshFree.so"), recursive=True)
+        plugin = os.path.abspath(found[0]) if found else None
+    if not plugin or not os.path.exists(plugin):
+        sys.exit("MeshFree.so not found: pass --plugin")
+    return plugin
 
+
+def resident_mb():
+    """The process's resident memory now (MiB)."""
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) for line in f if line.startswith("VmRSS:")) / 1024.0
+
+
+def start_worker(plugin_path):
+    """In a pvbatch worker: paraview.simple, the MPI controller (or None), this rank, the ranks, the plugin's proxies."""
     from paraview import simple
     from vtkmodules.vtkParallelCore import vtkMultiProcessController
 
@@ -71,7 +86,15 @@ def worker(args):
     rank = controller.GetLocalProcessId() if controller else 0
     ranks = controller.GetNumberOfProcesses() if controller else 1
     plugin = {"loaded": True}
-    simple.LoadPlugin(args.plugin, ns=plugin)
+    simple.LoadPlugin(plugin_path, ns=plugin)
+    return simple, controller, rank, ranks, plugin
+
+
+def worker(args):
+    import resource
+    import time
+
+    simple, controller, rank, ranks, plugin = start_worker(args.plugin)
     rows = []
     kind, case = args.kind, args.case
     cloud = simple.ProgrammableSource(OutputDataSetType="vtkPolyData", ScriptRequestInformation=INFO_SCRIPT,
@@ -85,8 +108,7 @@ def worker(args):
         probe = simple.Sphere(Center=[0.5, 0.5, 0.5], Radius=0.4, ThetaResolution=1000, PhiResolution=1000)
         probe.UpdatePipeline()
         approx = plugin["MeshlessApproximation"](Probe=probe, **settings)
-    with open("/proc/self/status") as f:
-        start_mb = next(int(line.split()[1]) for line in f if line.startswith("VmRSS:")) / 1024.0
+    start_mb = resident_mb()
     if controller:
         controller.Barrier()
     start = time.perf_counter()
@@ -114,12 +136,7 @@ def main():
     ap.add_argument("--kind", default="slabs", help=argparse.SUPPRESS)
     ap.add_argument("--case", default="grid", help=argparse.SUPPRESS)
     args = ap.parse_args()
-    if args.plugin is None:
-        here = os.path.dirname(os.path.abspath(__file__))
-        found = glob.glob(os.path.join(here, "..", "..", "build", "**", "MeshFree.so"), recursive=True)
-        args.plugin = os.path.abspath(found[0]) if found else None
-    if not args.plugin or not os.path.exists(args.plugin):
-        sys.exit("MeshFree.so not found: pass --plugin")
+    args.plugin = find_plugin(args.plugin)
     if args.worker:
         worker(args)
         return

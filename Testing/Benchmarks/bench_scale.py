@@ -27,6 +27,11 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The pvbatch worker's start, the piece-aware source's information script, the plugin lookup and the memory probe
+# are bench_distributed.py's.
+from bench_distributed import INFO_SCRIPT, find_plugin, resident_mb, start_worker  # noqa: E402
+
 CLOUD_SCRIPT = """
 import numpy as np
 from vtkmodules.util import numpy_support as ns
@@ -76,16 +81,7 @@ ids = ns.numpy_to_vtk(i, deep=1, array_type=VTK_ID_TYPE)
 ids.SetName('GlobalPointIds')
 out.GetPointData().SetGlobalIds(ids)
 """
-INFO_SCRIPT = """
-from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
-self.GetOutputInformation(0).Set(vtkAlgorithm.CAN_HANDLE_PIECE_REQUEST(), 1)
-"""
 STAGES = ("SetupSeconds", "ContourSeconds", "ProjectionSeconds", "ApproximationSeconds")
-
-
-def resident_mb():
-    with open("/proc/self/status") as f:
-        return next(int(line.split()[1]) for line in f if line.startswith("VmRSS:")) / 1024.0
 
 
 def field_value(data, name):
@@ -97,14 +93,7 @@ def worker(args):
     import resource
     import time
 
-    from paraview import simple
-    from vtkmodules.vtkParallelCore import vtkMultiProcessController
-
-    controller = vtkMultiProcessController.GetGlobalController()
-    rank = controller.GetLocalProcessId() if controller else 0
-    ranks = controller.GetNumberOfProcesses() if controller else 1
-    plugin = {"loaded": True}
-    simple.LoadPlugin(args.plugin, ns=plugin)
+    simple, controller, rank, ranks, plugin = start_worker(args.plugin)
     cloud = simple.ProgrammableSource(OutputDataSetType="vtkPolyData", ScriptRequestInformation=INFO_SCRIPT,
                                       Script=CLOUD_SCRIPT.format(count=args.points))
     cloud.UpdatePipeline()
@@ -146,12 +135,7 @@ def main():
     ap.add_argument("--out", help=argparse.SUPPRESS)
     ap.add_argument("--case", default="normals", help=argparse.SUPPRESS)
     args = ap.parse_args()
-    if args.plugin is None:
-        here = os.path.dirname(os.path.abspath(__file__))
-        found = glob.glob(os.path.join(here, "..", "..", "build", "**", "MeshFree.so"), recursive=True)
-        args.plugin = os.path.abspath(found[0]) if found else None
-    if not args.plugin or not os.path.exists(args.plugin):
-        sys.exit("MeshFree.so not found: pass --plugin")
+    args.plugin = find_plugin(args.plugin)
     if args.worker:
         args.points = args.points[0]
         worker(args)
