@@ -33,7 +33,8 @@ function(meshfree_add_mpi_test)
     set(pvbatch pvbatch)
   endif ()
   set(env "MESHFREE_PLUGIN=$<TARGET_FILE:MeshFree>" "MESHFREE_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
-    "MESHFREE_TEST_OUTPUT=${MESHFREE_TEST_OUTPUT_DIR}" "OMPI_ALLOW_RUN_AS_ROOT=1" "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
+    "MESHFREE_TEST_OUTPUT=${MESHFREE_TEST_OUTPUT_DIR}" "OMPI_ALLOW_RUN_AS_ROOT=1" "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1"
+    ${MESHFREE_PARAVIEW_TEST_ENV})
   set(fail "Traceback;(\n|^)ERROR: ;ERR\\|")
   set(extra ${arg_ARGS})
   set(test mpi.${arg_NAME})
