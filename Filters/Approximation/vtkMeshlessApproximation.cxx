@@ -536,6 +536,7 @@ int vtkMeshlessApproximation::RequestData(
   opts.Backend = static_cast<meshfree::ApproximationBackend>(this->Backend);
   opts.Smoothing = this->Smoothing;
   opts.RBFGlobalLimit = this->RBFGlobalLimit;
+  opts.PatchPoints = this->RBFPatchPoints;
   opts.RBFKernel = static_cast<meshfree::RBFKernelType>(this->RBFKernel);
   if (!std::isfinite(this->NullValue))
   {
@@ -940,6 +941,7 @@ void vtkMeshlessApproximation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NullValue: " << this->NullValue << "\n";
   os << indent << "Smoothing: " << this->Smoothing << "\n";
   os << indent << "RBFGlobalLimit: " << this->RBFGlobalLimit << "\n";
+  os << indent << "RBFPatchPoints: " << this->RBFPatchPoints << "\n";
   os << indent << "RBFKernel: " << this->RBFKernel << "\n";
   os << indent << "Backend: " << this->Backend << "\n";
   os << indent << "ModelBounds: " << this->ModelBounds[0] << ", " << this->ModelBounds[1] << ", "

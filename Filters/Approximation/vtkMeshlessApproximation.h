@@ -19,9 +19,9 @@
  * RBFGlobalLimit valid points, above it a partition of unity of local RBF fits on the PU-WLS lattice, RBF-PU;
  * Smoothing > 0 makes it a smoothing spline, with SciPy's `smoothing` meaning), Auto (a measured choice: 2D
  * clouds up to 150 points the global thin-plate spline or PU-WLS of degree 3 by their leave-one-out errors, larger
- * ones PU-WLS of degree 3; 1D and 3D clouds RBF;
- * with Smoothing > 0 the smoothing spline up to RBFGlobalLimit points, MLS above; see ResolveAuto in
- * Filters/Core/Approximation/ApproximationRBF.cxx). BasisDegree 0-3
+ * ones PU-WLS of degree 3; 3D clouds RBF (r^3) or PU-WLS of degree 3 over 40 neighbours by their leave-one-out
+ * errors at 32 sampled neighbourhoods; 1D clouds RBF; with Smoothing > 0 the smoothing spline up to
+ * RBFGlobalLimit points, MLS above; see ResolveAuto in Filters/Core/Approximation/ApproximationAuto.cxx). BasisDegree 0-3
  * in the cloud's own dimension (not used by RBF, whose tail is linear). WeightFunction: a meshfree::KernelType
  * (for RBF-PU, the blending weight of the partition of unity). With RBF or Auto the output's field data hold
  * `ApproximationMethod` (what ran, e.g. "RBF (global)", "RBF-PU", "PU-WLS degree 3") and
@@ -162,6 +162,14 @@ public:
   ///@}
 
   ///@{
+  /// RBF-PU: the points each local RBF fit takes (about; a ball around each lattice node holding this many),
+  /// 0 (default) for the measured default of the cloud's dimension (12 in 1D, 40 in 2D, 160 in 3D). More points
+  /// per patch: closer to the global fit's accuracy, at a cubic cost per patch.
+  vtkSetClampMacro(RBFPatchPoints, int, 0, 2000);
+  vtkGetMacro(RBFPatchPoints, int);
+  ///@}
+
+  ///@{
   /// RBF: the kernel, RBF_POLYHARMONIC (default: thin-plate spline in 2D, r^3 in 1D/3D) or RBF_WENDLAND_C2
   /// (compactly supported, support SupportRadius or SupportFactor x the RBF-PU cover radius; see
   /// meshfree::ApproximationOptions::RBFKernel). Auto uses the polyharmonic kernel.
@@ -252,6 +260,7 @@ protected:
   double NullValue = 0.0;
   double Smoothing = 0.0;
   int RBFGlobalLimit = 1000;
+  int RBFPatchPoints = 0;
   int RBFKernel = RBF_POLYHARMONIC;
   int Backend = BACKEND_AUTO;
   double ModelBounds[6] = { 0, 0, 0, 0, 0, 0 };

@@ -233,6 +233,12 @@ def main():
         results[label] = run_case(label, flat_cloud, "Auto", SUPPORTS["k-nearest"],
                                   probe_source if output == "probe" else None)
 
+    # Auto on a 3D cloud above RBFGlobalLimit: every rank gathers the sampled neighbourhoods of the leave-one-out
+    # estimate (r^3 or PU-WLS of degree 3), makes the serial run's choice and evaluates it through the halo.
+    for count, seed in ((1500, 29),) if QUICK else ((1500, 29), (3000, 31)):
+        label = f"Auto, 3D cloud of {count} points (sampled leave-one-out choice), grid"
+        results[label] = run_case(label, cloud_source("plain", count, seed), "Auto", SUPPORTS["k-nearest"], None)
+
     # SPH with Mass and Density (given volumes), and height fields.
     sph_cloud = cloud_source("sph", 2000, 3)
     results["SPH, volumes from Mass/Density"] = run_case("SPH, volumes from Mass/Density", sph_cloud, "SPH",

@@ -318,6 +318,35 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
     }
   }
   this->Rep.CloudDimension = dim;
+  // The PU-WLS lattice's box over every part (collective): PU-WLS and RBF-PU place their centres on it, and
+  // Auto's estimate samples it, so for Auto it is needed before the choice.
+  auto partitionBox = [&]() {
+    double box[6] = { 0, 0, 0, 0, 0, 0 }; // -umin, umax per axis of the frame
+    for (int a = 0; a < dim; ++a)
+    {
+      box[2 * a] = box[2 * a + 1] = -std::numeric_limits<double>::infinity();
+    }
+    double origin[3];
+    this->PUOrigin(origin);
+    for (Index p : ownPositions)
+    {
+      const double dx[3] = { sp[3 * p] - origin[0], sp[3 * p + 1] - origin[1], sp[3 * p + 2] - origin[2] };
+      double u[3];
+      this->Frame.Project<3>(dx, 1.0, u);
+      for (int a = 0; a < dim; ++a)
+      {
+        box[2 * a] = std::max(box[2 * a], -u[a]);
+        box[2 * a + 1] = std::max(box[2 * a + 1], u[a]);
+      }
+    }
+    this->PartitionMax(box, 6);
+    std::copy(box, box + 6, this->PartitionBox);
+  };
+  const bool boxDone = partition && this->Requested == ApproximationMethod::Auto;
+  if (boxDone)
+  {
+    partitionBox();
+  }
   this->ResolveAuto(globalValid, dim, partition);
 
   // What else is global, over every part of a distributed cloud (collective, in this order on every part).
@@ -350,26 +379,10 @@ bool Approximator::SetCloud(const double* xyz, Index n, const double* values, in
       (this->Opts.Method == ApproximationMethod::RBF &&
         (!this->RBFIsGlobal() || this->Opts.RBFKernel == RBFKernelType::WendlandC2)))
     {
-      double box[6] = { 0, 0, 0, 0, 0, 0 }; // -umin, umax per axis of the frame
-      for (int a = 0; a < dim; ++a)
+      if (!boxDone)
       {
-        box[2 * a] = box[2 * a + 1] = -std::numeric_limits<double>::infinity();
+        partitionBox();
       }
-      double origin[3];
-      this->PUOrigin(origin);
-      for (Index p : ownPositions)
-      {
-        const double dx[3] = { sp[3 * p] - origin[0], sp[3 * p + 1] - origin[1], sp[3 * p + 2] - origin[2] };
-        double u[3];
-        this->Frame.Project<3>(dx, 1.0, u);
-        for (int a = 0; a < dim; ++a)
-        {
-          box[2 * a] = std::max(box[2 * a], -u[a]);
-          box[2 * a + 1] = std::max(box[2 * a + 1], u[a]);
-        }
-      }
-      this->PartitionMax(box, 6);
-      std::copy(box, box + 6, this->PartitionBox);
     }
     else if (this->Opts.Method == ApproximationMethod::SPH && !this->Volumes.empty())
     {

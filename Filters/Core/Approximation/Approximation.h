@@ -30,7 +30,7 @@
  *   RBFGlobalLimit valid points (a dense solve), above it RBF-PU, local RBF fits on the PU-WLS lattice blended
  *   by the partition of unity. Coincident points are merged (mean value); Report().MethodUsed says which ran.
  * - Auto: resolved by SetCloud from the number of valid points (over every part), the dimension and Smoothing
- *   (see ResolveAuto in ApproximationRBF.cxx); Report().MethodUsed and MethodReason say what and why.
+ *   (see ResolveAuto in ApproximationAuto.cxx); Report().MethodUsed and MethodReason say what and why.
  *
  * Support radius: with SupportRadius <= 0, h = SupportFactor * (distance to the NeighborCount-th nearest
  * point) at each evaluation point, so that exactly NeighborCount points carry weight (SupportFactor = 1.1);
@@ -340,6 +340,15 @@ private:
   /// defined (no component, a singular system, ...). errors[0]: spline, errors[1]: PU-WLS, each the rms over the
   /// points of the residuals relative to the values' standard deviation, over the components.
   bool AutoLeaveOneOut(const CloudPartition* partition, double errors[2]) const;
+  /// Auto's estimate for a 3D cloud (ApproximationAuto.cxx): at about kAutoSamples positions of a coarse lattice
+  /// over the cloud's box, the leave-one-out residuals at the position's nearest points of a polyharmonic fit
+  /// over its rbfPoints nearest (an RBF-PU patch) and of a weighted polynomial fit of degree puDegree over its
+  /// puPoints nearest (a PU-WLS centre); the neighbourhoods are gathered over every part, so every part (and a
+  /// serial run) computes the same estimate whatever the points' order. errors[0]: the spline, errors[1]:
+  /// PU-WLS, each the rms residual relative to the values' standard deviation, over the components. False when
+  /// fewer than kAutoMinimumSamples positions had a full, well-posed neighbourhood.
+  bool AutoSampledLeaveOneOut(
+    const CloudPartition* partition, int rbfPoints, int puPoints, int puDegree, double errors[2]) const;
   /// Leave-one-out residuals (f - the fit without that point) of every valid point (by id, n x C, NaN where
   /// not defined) of this cloud (not distributed): the global polyharmonic spline (Rippa's formula, see
   /// SolvePolyharmonic), PU-WLS (each patch's weighted fit without the point, from its hat matrix's diagonal:

@@ -42,7 +42,7 @@
 namespace meshfree
 {
 /// Points per RBF-PU patch by the cloud's intrinsic dimension (PatchPoints = 0).
-constexpr int kRBFPatchPoints[4] = { 1, 12, 40, 80 };
+constexpr int kRBFPatchPoints[4] = { 1, 12, 40, 160 };
 /// A patch keeps at most this many times the patch size (its nearest points).
 constexpr int kRBFPatchCap = 8;
 /// Auto, 2D clouds without smoothing: PU-WLS of degree 3 above this many valid points; up to it, the global
@@ -54,6 +54,13 @@ constexpr Index kAutoRBFPoints2D = 150;
 /// Auto, small 2D clouds: the spline is chosen when its leave-one-out error is below PU-WLS's by more than this
 /// factor (it costs several times PU-WLS's time to evaluate: about 4x at 100 points and 10^4 evaluation points).
 constexpr double kAutoRBFMargin = 1.25;
+/// Auto, 3D clouds without smoothing: the polyharmonic spline r^3 (global, RBF-PU above RBFGlobalLimit) or
+/// PU-WLS of degree 3 over max(NeighborCount, kAutoPUPoints3D) neighbours (twice the 20 terms of the cubic
+/// basis), by their leave-one-out errors at about kAutoSamples sampled neighbourhoods (AutoSampledLeaveOneOut);
+/// PU-WLS is taken when its estimate is not above the spline's.
+constexpr int kAutoPUPoints3D = 40;
+constexpr double kAutoSamples = 32.0;
+constexpr double kAutoMinimumSamples = 4.0;
 /// Above this 1-norm condition estimate the Cholesky solution is not trusted (eigen-decomposition instead).
 constexpr double kRBFMaxCondition = 1e14;
 
