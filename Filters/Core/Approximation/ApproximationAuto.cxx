@@ -19,6 +19,21 @@
 
 namespace meshfree
 {
+namespace
+{
+/// Auto's estimates: the rms over `count` components of the relative mean squares summed in sums (spline,
+/// PU-WLS); false when there is none or one is not finite.
+bool RmsOverComponents(const double sums[2], int count, double errors[2])
+{
+  if (count == 0)
+  {
+    return false;
+  }
+  errors[0] = std::sqrt(sums[0] / count);
+  errors[1] = std::sqrt(sums[1] / count);
+  return std::isfinite(errors[0]) && std::isfinite(errors[1]);
+}
+} // namespace
 
 void Approximator::ResolveAuto(Index globalValid, int dimension, const CloudPartition* partition)
 {
@@ -267,13 +282,7 @@ bool Approximator::AutoLeaveOneOut(const CloudPartition* partition, double error
     sums[1] += squares[1] / variance;
     ++used;
   }
-  if (used == 0)
-  {
-    return false;
-  }
-  errors[0] = std::sqrt(sums[0] / used);
-  errors[1] = std::sqrt(sums[1] / used);
-  return std::isfinite(errors[0]) && std::isfinite(errors[1]);
+  return RmsOverComponents(sums, used, errors);
 }
 
 bool Approximator::LeaveOneOutRBF(std::vector<double>& residuals)
@@ -667,13 +676,7 @@ bool Approximator::AutoSampledLeaveOneOut(
     sums[1] += squares[2 * c + 1] / (thetaSums[1] * variance);
     ++components;
   }
-  if (components == 0)
-  {
-    return false;
-  }
-  errors[0] = std::sqrt(sums[0] / components);
-  errors[1] = std::sqrt(sums[1] / components);
-  return std::isfinite(errors[0]) && std::isfinite(errors[1]);
+  return RmsOverComponents(sums, components, errors);
 }
 
 } // namespace meshfree
