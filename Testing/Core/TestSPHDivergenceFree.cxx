@@ -1,12 +1,19 @@
-// DFSPH (SPH/SPHDivergenceFree.cxx): the hydrostatic column in 2D and 3D (average density error, containment;
-// the pressure against rho0 g (H - z) is printed: the issue's 2 % gate is NOT met, see below), thread-count
-// independence, the bit-identical continuation of a copied state (what the time cache relies on), hostile settings,
-// and the 2D dam-break front against Martin & Moyce 1952.
+// DFSPH (SPH/SPHDivergenceFree.cxx): the hydrostatic column in 2D and 3D (average density error, containment, rest,
+// the pressure against rho0 g (H - z)), thread-count independence, the bit-identical continuation of a copied state
+// (what the time cache relies on), hostile settings, and the 2D dam-break front against Martin & Moyce 1952.
 //
-// The hydrostatic column's pressure: measured relative L2 error 0.91 (2D) and 0.66 (3D) at t sqrt(g / H) = 10 (it
-// varies between 0.1 and 2 from one instant to the next; the issue's gate is 0.02): the
-// column's particles keep rearranging at speeds of order sqrt(g dx) (SPHDivergenceFree.cxx, "Known limitation"),
-// so the pressure scatters; it is printed, and only its finiteness and sign are asserted.
+// The hydrostatic column (issue 25 asks for a pressure L2 <= 2 %; NOT met): run with tolerances of 1e-4 % (density
+// and divergence, up to 500 iterations), it comes to rest (kinetic energy at t sqrt(g / H) = 10: 1.3e-6 (2D),
+// 2.0e-5 (3D) rho0 g H V) and its pressure's relative L2 error against rho0 g (H - z), averaged over t sqrt(g / H)
+// = 8, 8.5, ..., 10, is 0.042 (2D; worst sample 0.046) and 0.036 (3D; worst 0.038); one instant of a run stopped
+// only at 10 gave 0.094 (3D). Its depth-binned means are within about 3 %, the rest is a per-particle scatter of
+// the settled, no longer lattice-ordered particles. Asserted at 0.05 (the mean) and 1e-4 (kinetic energy) as
+// regression guards. Before a-d of SPHDivergenceFree.cxx ("Why": the wall coupling made the adjoint of the density
+// rate, the full Adami increase, no Shepard average in the warm start, both solves' impulses in Pressure) this test
+// gave, with the same settings, a mean L2 of 0.44 (2D; worst sample 0.97) and 0.15 (3D; worst 0.34) and a kinetic
+// energy of 5.8e-5 (2D) and 7.6e-4 (3D). At the default tolerances (0.01 % / 0.1 %) the
+// column still does not rest (L2 0.85 (2D), 0.89 (3D); "Why", e): the Jacobi iterations stop while the smooth part
+// of the pressure, which hardly changes the density, is still far from converged.
 #include "SPH/SPHFluid.h"
 #include "SPHScenes.h"
 
@@ -33,13 +40,15 @@ namespace
 {
 struct ColumnResult
 {
-  double PressureL2 = 0.0;
-  double AverageDensityError = 0.0; // mean of max(rho / rho0 - 1, 0) over all particles (compression only)
-  double WorstInterior = 0.0;       // max rho / rho0 - 1 (compression) below the surface layer
-  double KineticEnergy = 0.0;
+  double PressureL2 = 0.0;          // mean over the samples t sqrt(g / H) = 8, 8.5, ..., 10
+  double WorstPressureL2 = 0.0;     // largest of those
+  double AverageDensityError = 0.0; // mean of max(rho / rho0 - 1, 0) over all particles (compression only), at 10
+  double WorstInterior = 0.0;       // max rho / rho0 - 1 (compression) below the surface layer, at 10
+  double KineticEnergy = 0.0;       // at 10, over rho0 g H V H
 };
 
-// A column of height H = 40 dx (2D) or 16 dx (3D), run for t sqrt(g / H) = 10.
+// A column of height H = 40 dx (2D) or 16 dx (3D), run for t sqrt(g / H) = 10; its pressure's relative L2 error
+// against rho0 g (H - z) sampled at t sqrt(g / H) = 8, 8.5, ..., 10 (it fluctuates from one instant to the next).
 ColumnResult Column(int dimension, SPHState* out = nullptr)
 {
   const double dx = 0.01, g = 9.81;
@@ -49,25 +58,39 @@ ColumnResult Column(int dimension, SPHState* out = nullptr)
   p.Dimension = dimension;
   p.ParticleSpacing = dx;
   p.Viscosity = 0.5; // damps the start-up transient; the equilibrium does not depend on it
+  p.DensityTolerance = 1e-4; // percent: the pressure, not only the density, converged (see the header)
+  p.DivergenceTolerance = 1e-4;
+  p.MaximumIterations = 500;
   SetBox(p.FluidBounds, { 0.0, W, 0.0, dimension == 2 ? 0.0 : W, 0.0, H });
   SetBox(p.DomainBounds, { 0.0, W, 0.0, dimension == 2 ? 0.0 : W, 0.0, 1.25 * H });
   SPHFluid fluid;
   fluid.Setup(p);
   SPHState s = fluid.InitialState();
-  const double end = 10.0 * std::sqrt(H / g);
-  EXPECT_EQ(fluid.Advance(s, end), SPHFluid::Status::Ok) << fluid.ErrorMessage();
+  const double unit = std::sqrt(H / g);
+  ColumnResult r;
+  const int samples = 5;
+  for (int k = 0; k < samples; ++k)
+  {
+    EXPECT_EQ(fluid.Advance(s, (8.0 + 0.5 * k) * unit), SPHFluid::Status::Ok) << fluid.ErrorMessage();
+    double num = 0.0, den = 0.0;
+    for (Index i = 0; i < s.Size(); ++i)
+    {
+      const double exact = p.RestDensity * g * (H - s.Position[3 * i + 2]);
+      EXPECT_GE(s.Pressure[i], 0.0);
+      num += (s.Pressure[i] - exact) * (s.Pressure[i] - exact);
+      den += exact * exact;
+    }
+    const double l2 = std::sqrt(num / den);
+    std::printf("t sqrt(g / H) = %.1f: pressure L2 %.4f\n", 8.0 + 0.5 * k, l2);
+    r.PressureL2 += l2 / samples;
+    r.WorstPressureL2 = std::max(r.WorstPressureL2, l2);
+  }
   EXPECT_TRUE(SPHFluid::Statistics(s, fluid.ParticleMass()).Finite);
   EXPECT_TRUE(InsideDomain(s, p));
   std::printf("unconverged steps: %ld\n", fluid.UnconvergedSteps());
-  ColumnResult r;
-  double num = 0.0, den = 0.0;
   for (Index i = 0; i < s.Size(); ++i)
   {
     const double z = s.Position[3 * i + 2];
-    const double exact = p.RestDensity * g * (H - z);
-    EXPECT_GE(s.Pressure[i], 0.0);
-    num += (s.Pressure[i] - exact) * (s.Pressure[i] - exact);
-    den += exact * exact;
     r.AverageDensityError += std::max(s.Density[i] / p.RestDensity - 1.0, 0.0);
     if (z < H - fluid.SupportRadius())
     {
@@ -75,14 +98,13 @@ ColumnResult Column(int dimension, SPHState* out = nullptr)
     }
   }
   r.AverageDensityError /= static_cast<double>(std::max<Index>(1, s.Size()));
-  r.PressureL2 = std::sqrt(num / den);
   r.KineticEnergy = SPHFluid::Statistics(s, fluid.ParticleMass()).KineticEnergy /
     (p.RestDensity * g * H * W * (dimension == 3 ? W : 1.0) * H);
-  std::printf("DFSPH hydrostatic %dD: %ld particles, %ld steps, pressure L2 %.4f, average density error %.5f %%, "
-              "worst interior compression %.4f, KE/(rho0 g H V) %.2e, last step: %d density / %d divergence "
-              "iterations, solver's average error %.5f %%\n",
-    dimension, static_cast<long>(s.Size()), s.Steps, r.PressureL2, 100.0 * r.AverageDensityError, r.WorstInterior,
-    r.KineticEnergy, s.Report.LastDensityIterations, s.Report.LastDivergenceIterations,
+  std::printf("DFSPH hydrostatic %dD: %ld particles, %ld steps, pressure L2 mean %.4f / worst %.4f, average density "
+              "error %.5f %%, worst interior compression %.4f, KE/(rho0 g H V) %.2e, last step: %d density / %d "
+              "divergence iterations, solver's average error %.5f %%\n",
+    dimension, static_cast<long>(s.Size()), s.Steps, r.PressureL2, r.WorstPressureL2, 100.0 * r.AverageDensityError,
+    r.WorstInterior, r.KineticEnergy, s.Report.LastDensityIterations, s.Report.LastDivergenceIterations,
     100.0 * s.Report.AverageDensityError);
   if (out)
   {
@@ -97,6 +119,8 @@ TEST(SPHDivergenceFree, HydrostaticColumn2D)
   const ColumnResult r = Column(2);
   EXPECT_LE(r.AverageDensityError, 0.001); // the issue's gate: 0.1 %
   EXPECT_LE(r.WorstInterior, 0.01);
+  EXPECT_LE(r.KineticEnergy, 1e-4); // at rest (measured 1.3e-6)
+  EXPECT_LE(r.PressureL2, 0.05);    // measured 0.042; the issue's 0.02 is not reached (header)
 }
 
 TEST(SPHDivergenceFree, HydrostaticColumn3D)
@@ -104,6 +128,8 @@ TEST(SPHDivergenceFree, HydrostaticColumn3D)
   const ColumnResult r = Column(3);
   EXPECT_LE(r.AverageDensityError, 0.001);
   EXPECT_LE(r.WorstInterior, 0.01);
+  EXPECT_LE(r.KineticEnergy, 1e-4); // measured 2.0e-5
+  EXPECT_LE(r.PressureL2, 0.05);    // measured 0.036
 }
 
 namespace
@@ -265,10 +291,11 @@ TEST(SPHDivergenceFree, HostileSettings)
 }
 
 // The 2D dam break of TestSPHDamBreak.cxx (same scene, front definition and Lethe's 0.175 time-origin correction)
-// with DFSPH. Measured (a / dx = 40, 727 steps against WCSPH's ~3,000): corrected time origin within 10 % of
-// Martin & Moyce for 1.43 <= T <= 3.33 (at most 9.8 %, from T = 2.32 on within 1.7 %), but +8.1 % at T = 0.84 and
-// +11.7 % at T = 1.19 (the issue's 10 % gate is missed there; guarded at 12.5 % so that a regression shows); raw
-// time origin within 10 % for T >= 2.32 (at most 9.3 %), and an early lead of 12-23 % (guarded at 25 %).
+// with DFSPH. Measured (a / dx = 40, 765 steps against WCSPH's ~3,000): corrected time origin within 10 % of
+// Martin & Moyce for 1.43 <= T <= 3.33 (at most 9.0 %, from T = 2.32 on within 1.4 %), but +8.1 % at T = 0.84 and
+// +10.7 % at T = 1.19 (the issue's 10 % gate is missed there; guarded at 12.5 % so that a regression shows); raw
+// time origin within 10 % for T >= 2.32 (at most 8.9 %), and an early lead of 12-22 % (guarded at 25 %). (Before
+// the wall coupling of SPHDivergenceFree.cxx was made consistent: 727 steps, at most 9.8 %, +11.7 % at T = 1.19.)
 TEST(SPHDivergenceFree, DamBreakFrontAgainstMartinMoyce)
 {
   using namespace sphscenes;

@@ -173,8 +173,8 @@ struct SPHState
   std::vector<double> Density;      ///< n
   std::vector<double> Pressure;     ///< n
   std::vector<std::int64_t> Id;     ///< n, stable across time
-  /// DFSPH only (empty for WCSPH): the accumulated stiffness of each particle's last density solve (kappa, m^2/s^2;
-  /// pressure = rho kappa) and divergence solve (kappa dt, m^2/s): the warm start of the next step.
+  /// DFSPH only (empty for WCSPH): the accumulated stiffness kappa (m^2/s^2, P / dt) of each particle's last density
+  /// solve and divergence solve: the warm start of the next step; pressure = rho (the sum of both).
   std::vector<double> DensityStiffness, DivergenceStiffness;
   SPHSolverReport Report; ///< DFSPH: what the Advance() call that produced this state did
 
