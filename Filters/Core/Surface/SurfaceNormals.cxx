@@ -65,6 +65,35 @@ int NearestDistinct(const NeighborGrid& grid, const double x[3], int k, std::vec
   }
 }
 
+#if defined(__GNUC__)
+/// Two doubles side by side (GCC/Clang vector extension): lane-wise IEEE arithmetic, the same bits as two scalars.
+typedef double Pair __attribute__((vector_size(16)));
+#else
+struct Pair
+{
+  double Lane[2];
+  double operator[](int i) const { return this->Lane[i]; }
+  Pair& operator+=(const Pair& b)
+  {
+    this->Lane[0] += b.Lane[0];
+    this->Lane[1] += b.Lane[1];
+    return *this;
+  }
+};
+inline Pair operator+(const Pair& a, const Pair& b)
+{
+  return Pair{ { a.Lane[0] + b.Lane[0], a.Lane[1] + b.Lane[1] } };
+}
+inline Pair operator*(double a, const Pair& b)
+{
+  return Pair{ { a * b.Lane[0], a * b.Lane[1] } };
+}
+inline Pair operator*(const Pair& a, const Pair& b)
+{
+  return Pair{ { a.Lane[0] * b.Lane[0], a.Lane[1] * b.Lane[1] } };
+}
+#endif
+
 /// The mean offset (mean[3]) and the covariance's eigen-decomposition of `count` points given by point(m), in
 /// coordinates shifted to x and scaled by inv (|d| <= 1): one pass of first and second moments,
 /// C = E[d d^T] - E[d] E[d]^T. False when the points span no plane (collinear or coincident: the closed-form
@@ -73,22 +102,22 @@ template <class Point>
 bool ScaledCovariance(size_t count, const Point& point, const double x[3], double inv, double mean[3],
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig)
 {
-  double m1[3] = { 0.0, 0.0, 0.0 };
-  double m2[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; // xx, xy, xz, yy, yz, zz
+  // The sums in pairs (Pair: each lane one sum's products and additions, in the points' order).
+  Pair m1xy = { 0.0, 0.0 }, m2xx_xy = m1xy, m2xz_yz = m1xy, m2yy_zz = m1xy;
+  double m1z = 0.0;
   for (size_t m = 0; m < count; ++m)
   {
     const double* p = point(m);
     const double d0 = (p[0] - x[0]) * inv, d1 = (p[1] - x[1]) * inv, d2 = (p[2] - x[2]) * inv;
-    m1[0] += d0;
-    m1[1] += d1;
-    m1[2] += d2;
-    m2[0] += d0 * d0;
-    m2[1] += d0 * d1;
-    m2[2] += d0 * d2;
-    m2[3] += d1 * d1;
-    m2[4] += d1 * d2;
-    m2[5] += d2 * d2;
+    const Pair xy = { d0, d1 }, yz = { d1, d2 };
+    m1xy += xy;
+    m1z += d2;
+    m2xx_xy += d0 * xy;
+    m2xz_yz += d2 * xy;
+    m2yy_zz += yz * yz;
   }
+  const double m1[3] = { m1xy[0], m1xy[1], m1z };
+  const double m2[6] = { m2xx_xy[0], m2xx_xy[1], m2xz_yz[0], m2yy_zz[0], m2xz_yz[1], m2yy_zz[1] }; // xx xy xz yy yz zz
   const double w = 1.0 / static_cast<double>(count);
   for (int a = 0; a < 3; ++a)
   {
@@ -165,31 +194,6 @@ void SpreadSubset(const Index* pos, size_t count, size_t used, Index* picked)
     }
   }
 }
-
-#if defined(__GNUC__)
-/// Two doubles side by side (GCC/Clang vector extension): lane-wise IEEE arithmetic, the same bits as two scalars.
-typedef double Pair __attribute__((vector_size(16)));
-#else
-struct Pair
-{
-  double Lane[2];
-  double operator[](int i) const { return this->Lane[i]; }
-  Pair& operator+=(const Pair& b)
-  {
-    this->Lane[0] += b.Lane[0];
-    this->Lane[1] += b.Lane[1];
-    return *this;
-  }
-};
-inline Pair operator+(const Pair& a, const Pair& b)
-{
-  return Pair{ { a.Lane[0] + b.Lane[0], a.Lane[1] + b.Lane[1] } };
-}
-inline Pair operator*(double a, const Pair& b)
-{
-  return Pair{ { a * b.Lane[0], a * b.Lane[1] } };
-}
-#endif
 
 /// A degree-2 jet (Cazals & Pouget 2005) over up to MaxFit of the points at sorted positions pos[0..count)
 /// (a subset spread evenly over the list when there are more: the list is in cell order, so the subset is
@@ -800,21 +804,32 @@ bool EstimateNormals(
             grid.FindWithinRadiusPositions(x, first, pos, r2);
           }
           double queried = first;
-          // The near part of the list, once: the k nearest and the outliers' small neighbourhood lie in it.
-          if (mine.Small.size() < pos.size())
+          // The near part of the list, once (a copy: the list may be cut or queried again below): the k nearest
+          // and the outliers' small neighbourhood lie in it. When it is narrower than the list, from a query of its
+          // own (a few cells: a pass over the wide list cost more), a little wider since its radius squared may
+          // round below nearLimit2, then cut exactly: the list's points within sqrt(nearLimit2), in its order.
+          if (!(first > 0.0 && nearLimit2 < first * first))
           {
-            mine.Small.resize(pos.size()); // both grow once per thread
-            mine.SmallD2.resize(pos.size());
+            mine.Small.assign(pos.begin(), pos.end());
+            mine.SmallD2.assign(r2.begin(), r2.end());
           }
-          size_t nearCount = 0;
-          for (size_t j = 0; j < pos.size(); ++j) // branch-free: the test decides whether the slot is kept
+          else
           {
-            mine.Small[nearCount] = pos[j];
-            mine.SmallD2[nearCount] = r2[j];
-            nearCount += r2[j] <= nearLimit2 ? 1 : 0;
+            grid.FindWithinRadiusPositions(x, std::sqrt(nearLimit2) * (1.0 + 1e-9), mine.Small, mine.SmallD2);
+            size_t nearCount = 0;
+            for (size_t j = 0; j < mine.Small.size(); ++j) // branch-free: the test decides whether j is kept
+            {
+              mine.Small[nearCount] = mine.Small[j];
+              mine.SmallD2[nearCount] = mine.SmallD2[j];
+              nearCount += mine.SmallD2[j] <= nearLimit2 ? 1 : 0;
+            }
+            mine.Small.resize(nearCount);
+            mine.SmallD2.resize(nearCount);
           }
-          if (!(first > 0.0 && NearestOfList(sorted, mine.Small.data(), mine.SmallD2.data(), nearCount, near2,
-                                 nearestLimit2, k, order, row, degree, field.NeighborDistance[id], keys)))
+          const Index* nearPos = mine.Small.data();
+          const double* nearD2 = mine.SmallD2.data();
+          if (!(first > 0.0 && NearestOfList(sorted, nearPos, nearD2, mine.Small.size(), near2, nearestLimit2, k,
+                                 order, row, degree, field.NeighborDistance[id], keys)))
           {
             const int found = NearestDistinct(grid, x, k, ids, d2, field.NeighborDistance[id]);
             int kept = 0;
@@ -867,9 +882,9 @@ bool EstimateNormals(
           {
             const double cut = small * small;
             const bool inNear = queried > 0.0 && cut <= nearLimit2;
-            const Index* from = inNear ? mine.Small.data() : pos.data();
-            const double* fromD2 = inNear ? mine.SmallD2.data() : r2.data();
-            const size_t fromCount = inNear ? nearCount : pos.size();
+            const Index* from = inNear ? nearPos : pos.data();
+            const double* fromD2 = inNear ? nearD2 : r2.data();
+            const size_t fromCount = inNear ? mine.Small.size() : pos.size();
             if (mine.Local.size() < fromCount)
             {
               mine.Local.resize(fromCount); // grows once per thread
