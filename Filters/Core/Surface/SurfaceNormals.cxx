@@ -65,6 +65,35 @@ int NearestDistinct(const NeighborGrid& grid, const double x[3], int k, std::vec
   }
 }
 
+#if defined(__GNUC__)
+/// Two doubles side by side (GCC/Clang vector extension): lane-wise IEEE arithmetic, the same bits as two scalars.
+typedef double Pair __attribute__((vector_size(16)));
+#else
+struct Pair
+{
+  double Lane[2];
+  double operator[](int i) const { return this->Lane[i]; }
+  Pair& operator+=(const Pair& b)
+  {
+    this->Lane[0] += b.Lane[0];
+    this->Lane[1] += b.Lane[1];
+    return *this;
+  }
+};
+inline Pair operator+(const Pair& a, const Pair& b)
+{
+  return Pair{ { a.Lane[0] + b.Lane[0], a.Lane[1] + b.Lane[1] } };
+}
+inline Pair operator*(double a, const Pair& b)
+{
+  return Pair{ { a * b.Lane[0], a * b.Lane[1] } };
+}
+inline Pair operator*(const Pair& a, const Pair& b)
+{
+  return Pair{ { a.Lane[0] * b.Lane[0], a.Lane[1] * b.Lane[1] } };
+}
+#endif
+
 /// The mean offset (mean[3]) and the covariance's eigen-decomposition of `count` points given by point(m), in
 /// coordinates shifted to x and scaled by inv (|d| <= 1): one pass of first and second moments,
 /// C = E[d d^T] - E[d] E[d]^T. False when the points span no plane (collinear or coincident: the closed-form
@@ -73,22 +102,22 @@ template <class Point>
 bool ScaledCovariance(size_t count, const Point& point, const double x[3], double inv, double mean[3],
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig)
 {
-  double m1[3] = { 0.0, 0.0, 0.0 };
-  double m2[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; // xx, xy, xz, yy, yz, zz
+  // The sums in pairs (Pair: each lane one sum's products and additions, in the points' order).
+  Pair m1xy = { 0.0, 0.0 }, m2xx_xy = m1xy, m2xz_yz = m1xy, m2yy_zz = m1xy;
+  double m1z = 0.0;
   for (size_t m = 0; m < count; ++m)
   {
     const double* p = point(m);
     const double d0 = (p[0] - x[0]) * inv, d1 = (p[1] - x[1]) * inv, d2 = (p[2] - x[2]) * inv;
-    m1[0] += d0;
-    m1[1] += d1;
-    m1[2] += d2;
-    m2[0] += d0 * d0;
-    m2[1] += d0 * d1;
-    m2[2] += d0 * d2;
-    m2[3] += d1 * d1;
-    m2[4] += d1 * d2;
-    m2[5] += d2 * d2;
+    const Pair xy = { d0, d1 }, yz = { d1, d2 };
+    m1xy += xy;
+    m1z += d2;
+    m2xx_xy += d0 * xy;
+    m2xz_yz += d2 * xy;
+    m2yy_zz += yz * yz;
   }
+  const double m1[3] = { m1xy[0], m1xy[1], m1z };
+  const double m2[6] = { m2xx_xy[0], m2xx_xy[1], m2xz_yz[0], m2yy_zz[0], m2xz_yz[1], m2yy_zz[1] }; // xx xy xz yy yz zz
   const double w = 1.0 / static_cast<double>(count);
   for (int a = 0; a < 3; ++a)
   {
@@ -147,6 +176,25 @@ struct JetFit
   bool Valid = false;
 };
 
+/// The sorted positions of `used` of the count entries of pos spread evenly over the list: entry m * count / used
+/// for m < used (all of them when used == count), stepped without a division per entry.
+void SpreadSubset(const Index* pos, size_t count, size_t used, Index* picked)
+{
+  const size_t whole = count / used, rest = count % used;
+  size_t at = 0, carry = 0;
+  for (size_t m = 0; m < used; ++m)
+  {
+    picked[m] = pos[at]; // at = m * count / used, carry = m * count % used
+    at += whole;
+    carry += rest;
+    if (carry >= used)
+    {
+      carry -= used;
+      ++at;
+    }
+  }
+}
+
 /// A degree-2 jet (Cazals & Pouget 2005) over up to MaxFit of the points at sorted positions pos[0..count)
 /// (a subset spread evenly over the list when there are more: the list is in cell order, so the subset is
 /// spread over the neighbourhood and depends only on the positions), in coordinates shifted to x and scaled
@@ -155,18 +203,22 @@ struct JetFit
 /// its distance to its neighbours' surface) and the normal is n - a1 t1 - a2 t2. Exact on quadrics; for a
 /// support symmetric about x the slopes are orthogonal to the quadratic terms, so noise tilts them no more
 /// than it tilts PCA's plane. Fewer than 2 neighbours per term or a degenerate jet: the PCA plane.
-JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double x[3], double scale, size_t maxFit)
+JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double x[3], double scale)
 {
   JetFit out;
   if (count < 3 || !(scale > 0.0))
   {
     return out;
   }
-  const size_t used = std::min(count, std::max<size_t>(maxFit, 3));
-  auto at = [&](size_t m) { return sorted + 3 * pos[used == count ? m : m * count / used]; };
+  const size_t used = std::min(count, MaxFit);
+  Index picked[MaxFit];
+  SpreadSubset(pos, count, used, picked);
+  auto at = [&](size_t m) { return sorted + 3 * picked[m]; };
   // The frame (PCA) from fewer points still: the jet corrects its tilt.
   const size_t framed = std::min(used, FramePoints);
-  auto frameAt = [&](size_t m) { return sorted + 3 * pos[framed == count ? m : m * count / framed]; };
+  Index framePicked[FramePoints];
+  SpreadSubset(pos, count, framed, framePicked);
+  auto frameAt = [&](size_t m) { return sorted + 3 * framePicked[m]; };
   const double inv = 1.0 / scale;
   double m1[3];
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
@@ -187,6 +239,12 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
     double hh = 0.0;
     size_t fitted = 0;
     const double e1[3] = { t1(0), t1(1), t1(2) }, e2[3] = { t2(0), t2(1), t2(2) }, e3[3] = { n(0), n(1), n(2) };
+    // Pairs of the sums side by side (each lane the products and additions of one sum, in the order of the list:
+    // the bits of a scalar loop, in about half the instructions).
+    const Pair f0 = { e1[0], e2[0] }, f1 = { e1[1], e2[1] }, f2 = { e1[2], e2[2] };
+    Pair s12 = { 0.0, 0.0 }, s34 = s12, s67 = s12, s89 = s12, s1011 = s12, s1213 = s12, h12 = s12, h34 = s12,
+         h5h = s12;
+    double s5 = 0.0, s14 = 0.0, h0 = 0.0;
     for (size_t m = 0; m < used; ++m)
     {
       const double* p = at(m);
@@ -195,33 +253,47 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
       {
         continue;
       }
-      const double u = d0 * e1[0] + d1 * e1[1] + d2 * e1[2];
-      const double v = d0 * e2[0] + d1 * e2[1] + d2 * e2[2];
+      const Pair uv2 = d0 * f0 + d1 * f1 + d2 * f2; // (u, v)
+      const double u = uv2[0], v = uv2[1];
       const double h = d0 * e3[0] + d1 * e3[1] + d2 * e3[2];
-      const double uu = u * u, uv = u * v, vv = v * v;
-      su[1] += u;
-      su[2] += v;
-      su[3] += uu;
-      su[4] += uv;
-      su[5] += vv;
-      su[6] += uu * u;
-      su[7] += uu * v;
-      su[8] += u * vv;
-      su[9] += vv * v;
-      su[10] += uu * uu;
-      su[11] += uu * uv;
-      su[12] += uu * vv;
-      su[13] += uv * vv;
-      su[14] += vv * vv;
-      sh[0] += h;
-      sh[1] += h * u;
-      sh[2] += h * v;
-      sh[3] += h * uu;
-      sh[4] += h * uv;
-      sh[5] += h * vv;
-      hh += h * h;
+      const Pair quad = u * uv2; // (uu, uv)
+      const double uu = quad[0], vv = v * v;
+      s12 += uv2;
+      s34 += quad;
+      s5 += vv;
+      s67 += uu * uv2;    // (uuu, uuv)
+      s89 += vv * uv2;    // (uvv, vvv)
+      s1011 += uu * quad; // (uuuu, uuuv)
+      s1213 += vv * quad; // (uuvv, uvvv)
+      s14 += vv * vv;
+      h0 += h;
+      h12 += h * uv2;
+      h34 += h * quad;
+      const Pair vh = { vv, h };
+      h5h += h * vh; // (h vv, h h)
       ++fitted;
     }
+    su[1] = s12[0];
+    su[2] = s12[1];
+    su[3] = s34[0];
+    su[4] = s34[1];
+    su[5] = s5;
+    su[6] = s67[0];
+    su[7] = s67[1];
+    su[8] = s89[0];
+    su[9] = s89[1];
+    su[10] = s1011[0];
+    su[11] = s1011[1];
+    su[12] = s1213[0];
+    su[13] = s1213[1];
+    su[14] = s14;
+    sh[0] = h0;
+    sh[1] = h12[0];
+    sh[2] = h12[1];
+    sh[3] = h34[0];
+    sh[4] = h34[1];
+    sh[5] = h5h[0];
+    hh = h5h[1];
     su[0] = static_cast<double>(fitted);
     // M(i, j) = sum b_i b_j: the monomial of b_i times b_j.
     static constexpr int Product[6][6] = { { 0, 1, 2, 3, 4, 5 }, { 1, 3, 4, 6, 7, 8 }, { 2, 4, 5, 7, 8, 9 },
@@ -274,24 +346,45 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
 /// to its k-th nearest other point and its `degree` nearest others (original indices, in the neighbour order
 /// of NeighborGrid::FindKNearest: distance, then position, then index), exact duplicates of the point left
 /// out; only the list's points within sqrt(limit2) count (a wide list: its nearest part holds the k nearest, and
-/// selecting among fewer is faster). False (nothing written) when there are fewer than k. `keys` is scratch.
-bool NearestOfList(const double* sorted, const std::vector<Index>& pos, const std::vector<double>& r2, double limit2,
-  int k, const std::vector<Index>& order, std::int32_t* row, int degree, double& kth, std::vector<double>& keys)
+/// selecting among fewer is faster): first those within sqrt(first2) (<= limit2; usually enough), else all of
+/// them. False (nothing written) when there are fewer than k. `keys` is scratch.
+bool NearestOfList(const double* sorted, const Index* pos, const double* r2, size_t count, double first2,
+  double limit2, int k, const std::vector<Index>& order, std::int32_t* row, int degree, double& kth,
+  std::vector<double>& keys)
 {
-  keys.clear();
-  for (double d2 : r2)
-  {
-    if (d2 > 0.0 && d2 <= limit2) // the point itself and its exact duplicates are not neighbours
-    {
-      keys.push_back(d2);
-    }
-  }
-  if (keys.size() < static_cast<size_t>(k) || k <= 0)
+  if (k <= 0)
   {
     return false;
   }
-  std::nth_element(keys.begin(), keys.begin() + (k - 1), keys.end());
+  if (keys.size() < count)
+  {
+    keys.resize(count); // grows once per thread
+  }
+  // The k-th smallest of the distances within the limit (the point itself and its exact duplicates are not
+  // neighbours): the same value whichever limit holds k of them, and a smaller set is faster to select in.
+  size_t kept2 = 0;
+  for (const double bound : { first2, limit2 })
+  {
+    kept2 = 0;
+    for (size_t j = 0; j < count; ++j) // branch-free: the test decides whether the slot is kept
+    {
+      const double d2 = r2[j];
+      keys[kept2] = d2;
+      kept2 += d2 > 0.0 && d2 <= bound ? 1 : 0;
+    }
+    if (kept2 >= static_cast<size_t>(k) || bound >= limit2)
+    {
+      break;
+    }
+  }
+  if (kept2 < static_cast<size_t>(k))
+  {
+    return false;
+  }
+  std::nth_element(keys.begin(), keys.begin() + (k - 1), keys.begin() + static_cast<std::ptrdiff_t>(kept2));
   kth = std::sqrt(keys[k - 1]);
+  // The degree <= k nearest lie within the k-th distance.
+  limit2 = keys[k - 1];
   // The `degree` first in the neighbour order, kept sorted by insertion (degree is small).
   constexpr int MaxDegree = 64;
   const int want = std::min(std::min(degree, k), MaxDegree);
@@ -301,7 +394,7 @@ bool NearestOfList(const double* sorted, const std::vector<Index>& pos, const st
   auto before = [&](double d2, Index p, double e2, Index q) {
     return NeighborGrid::NeighborBefore(d2, sorted + 3 * p, order[p], e2, sorted + 3 * q, order[q]);
   };
-  for (size_t j = 0; j < pos.size(); ++j)
+  for (size_t j = 0; j < count; ++j)
   {
     const double d2 = r2[j];
     const Index p = pos[j];
@@ -406,7 +499,7 @@ void SharpFeatures(
       if (small < radius)
       {
         grid.FindWithinRadiusPositions(x, small, mine.Positions, mine.Dist2);
-        const JetFit fit = FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, small, MaxFit);
+        const JetFit fit = FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, small);
         if (fit.Valid)
         {
           std::copy(fit.Normal, fit.Normal + 3, &replaced[3 * s]);
@@ -504,7 +597,7 @@ void EstimateNormalRadius(const NeighborGrid& grid, const NormalOptions& options
       {
         const double* x = sorted + 3 * (j * nv / samples);
         grid.FindWithinRadiusPositions(x, radius, mine.Positions, mine.Dist2);
-        const JetFit fit = FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, radius, MaxFit);
+        const JetFit fit = FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, radius);
         rms[j] = fit.Valid ? fit.Rms : 0.0;
         curvature[j] = fit.Valid ? fit.Curvature : 0.0;
       }
@@ -669,6 +762,10 @@ bool EstimateNormals(
   const double near2 = fixed ? first * first : 1.21 * typical * typical;
   // The near part of the first list: the k nearest (within near2) and the outliers' neighbourhood.
   const double nearLimit2 = fixed ? near2 : std::max(near2, field.Scale.Radius * field.Scale.Radius);
+  // The k nearest are those of the near part when it holds k within a distance up to which the query is complete
+  // (its whole reach, not only near2: a point whose k-th neighbour lies a little beyond near2 would otherwise take
+  // a k-nearest query and a second radius query, for the same result).
+  const double nearestLimit2 = std::min(nearLimit2, first * first);
   const double* sorted = grid.SortedPoints();
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
@@ -707,19 +804,32 @@ bool EstimateNormals(
             grid.FindWithinRadiusPositions(x, first, pos, r2);
           }
           double queried = first;
-          // The near part of the list, once: the k nearest and the outliers' small neighbourhood lie in it.
-          mine.Small.clear();
-          mine.SmallD2.clear();
-          for (size_t j = 0; j < pos.size(); ++j)
+          // The near part of the list, once (a copy: the list may be cut or queried again below): the k nearest
+          // and the outliers' small neighbourhood lie in it. When it is narrower than the list, from a query of its
+          // own (a few cells: a pass over the wide list cost more), a little wider since its radius squared may
+          // round below nearLimit2, then cut exactly: the list's points within sqrt(nearLimit2), in its order.
+          if (!(first > 0.0 && nearLimit2 < first * first))
           {
-            if (r2[j] <= nearLimit2)
-            {
-              mine.Small.push_back(pos[j]);
-              mine.SmallD2.push_back(r2[j]);
-            }
+            mine.Small.assign(pos.begin(), pos.end());
+            mine.SmallD2.assign(r2.begin(), r2.end());
           }
-          if (!(first > 0.0 && NearestOfList(sorted, mine.Small, mine.SmallD2, near2, k, order, row, degree,
-                                 field.NeighborDistance[id], keys)))
+          else
+          {
+            grid.FindWithinRadiusPositions(x, std::sqrt(nearLimit2) * (1.0 + 1e-9), mine.Small, mine.SmallD2);
+            size_t nearCount = 0;
+            for (size_t j = 0; j < mine.Small.size(); ++j) // branch-free: the test decides whether j is kept
+            {
+              mine.Small[nearCount] = mine.Small[j];
+              mine.SmallD2[nearCount] = mine.SmallD2[j];
+              nearCount += mine.SmallD2[j] <= nearLimit2 ? 1 : 0;
+            }
+            mine.Small.resize(nearCount);
+            mine.SmallD2.resize(nearCount);
+          }
+          const Index* nearPos = mine.Small.data();
+          const double* nearD2 = mine.SmallD2.data();
+          if (!(first > 0.0 && NearestOfList(sorted, nearPos, nearD2, mine.Small.size(), near2, nearestLimit2, k,
+                                 order, row, degree, field.NeighborDistance[id], keys)))
           {
             const int found = NearestDistinct(grid, x, k, ids, d2, field.NeighborDistance[id]);
             int kept = 0;
@@ -754,7 +864,7 @@ bool EstimateNormals(
             pos.resize(kept);
             r2.resize(kept);
           }
-          const JetFit fit = FitJet(sorted, pos.data(), pos.size(), x, radius, MaxFit);
+          const JetFit fit = FitJet(sorted, pos.data(), pos.size(), x, radius);
           if (!fit.Valid)
           {
             ++failed;
@@ -772,18 +882,21 @@ bool EstimateNormals(
           {
             const double cut = small * small;
             const bool inNear = queried > 0.0 && cut <= nearLimit2;
-            const std::vector<Index>& from = inNear ? mine.Small : pos;
-            const std::vector<double>& fromD2 = inNear ? mine.SmallD2 : r2;
-            mine.Local.clear();
-            for (size_t j = 0; j < from.size(); ++j)
+            const Index* from = inNear ? nearPos : pos.data();
+            const double* fromD2 = inNear ? nearD2 : r2.data();
+            const size_t fromCount = inNear ? mine.Small.size() : pos.size();
+            if (mine.Local.size() < fromCount)
             {
-              if (fromD2[j] <= cut)
-              {
-                mine.Local.push_back(from[j]);
-              }
+              mine.Local.resize(fromCount); // grows once per thread
             }
-            const JetFit local = FitJet(sorted, mine.Local.data(), mine.Local.size(), x, small, MaxFit);
-            field.Residual[id] = local.Valid ? local.Residual : fit.Residual;
+            size_t local = 0;
+            for (size_t j = 0; j < fromCount; ++j) // branch-free
+            {
+              mine.Local[local] = from[j];
+              local += fromD2[j] <= cut ? 1 : 0;
+            }
+            const JetFit localFit = FitJet(sorted, mine.Local.data(), local, x, small);
+            field.Residual[id] = localFit.Valid ? localFit.Residual : fit.Residual;
           }
           const double total = fit.Eigenvalues[0] + fit.Eigenvalues[1] + fit.Eigenvalues[2];
           field.SurfaceVariation[id] = total > 0.0 ? fit.Eigenvalues[0] / total : 0.0;
