@@ -5,8 +5,10 @@
  *
  * Input port 0 is a point cloud (vtkPointSet). The output is the input (shallow copy) with the point arrays
  * - `Normals`: unit, consistently oriented (outward on a closed object); also the active normals;
- * - `Curvature` (unless ComputeCurvature is off): mean curvature of the algebraic sphere fitted at the point,
- *   1 / length, positive where the surface is convex with respect to the normals;
+ * - `Curvature` (unless ComputeCurvature is off): mean curvature, 1 / length, positive where the surface is convex
+ *   with respect to the normals, exact on spheres: from the normals' own jets (a second, sphere-exact jet over the
+ *   same neighbours), averaged over the nearest neighbours; with ProjectPoints, that of the algebraic sphere
+ *   fitted at the moved point (Core/Surface/CloudNormals.h);
  * - `SurfaceVariation`: l0 / (l0 + l1 + l2) of the neighbourhood's PCA (0 on a plane, 1/3 for isotropic scatter);
  * - `OrientationConfidence`: how unambiguous the orientation was (below 0.5: ambiguous);
  * - `vtkValidPointMask`: 0 where no normal could be computed (NaN/Inf coordinates, degenerate
@@ -94,8 +96,8 @@ public:
   ///@}
 
   ///@{
-  /// Compute the Curvature array (default on). Its sphere fits cost about as much as the normals and their
-  /// orientation together; off, the output has no Curvature (unless ProjectPoints, which fits anyway).
+  /// Compute the Curvature array (default on). It costs 10-20 % of the normals' time (a second jet over
+  /// each normal's neighbours, then averages over the nearest neighbours); off, the output has no Curvature.
   vtkSetMacro(ComputeCurvature, bool);
   vtkGetMacro(ComputeCurvature, bool);
   vtkBooleanMacro(ComputeCurvature, bool);

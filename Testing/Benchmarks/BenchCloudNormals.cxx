@@ -1,7 +1,7 @@
 // Meshless Normals' core (ComputeCloudNormals) on bench_scale.py's scan-like cloud, without VTK: the time of
 // its stages and a digest of every output array's bits (to check that a speed-up leaves the results unchanged).
 // Usage: BenchCloudNormals [--points N] [--repeat R] [--curvature 0|1] [--shuffle 0|1] [--full 0|1] [--wide 0|1]
-//        [--support RADIUS] [--xyz CLOUD.xyz]
+//        [--support RADIUS] [--xyz CLOUD.xyz] [--noise FRACTION] [--accuracy 0|1]
 // The cloud: a sphere (radius 0.5) inside a torus (R = 1, r = 0.25), points spread evenly over their area, each
 // moved along its normal by Gaussian noise of 0.1 % of the bounding box's diagonal (bench_scale.py's formula;
 // libm's log/cos may differ from numpy's in the last bit). --xyz reads "x y z" lines instead. --shuffle 1 permutes
@@ -9,11 +9,15 @@
 // --wide 0 and --support R: NormalOptions::WideNormals and ::SupportRadius (Meshless Surface's narrow normals, a
 // fixed radius). Stages: the grid and EstimateNormals timed alone, then the whole ComputeCloudNormals (grid, normals,
 // orientation, curvature; --full 0 skips it). Threads: all the CPUs, or MESHFREE_NUM_THREADS.
+// --noise: sigma as a fraction of the diagonal (default 0.001). --accuracy 1: the Curvature's relative error against
+// the exact mean curvature (sphere 1 / rs; torus (R + 2 r cos v) / (2 r (R + r cos v))), mean / p99 / max, separately
+// on the sphere and the torus (points with Curvature 0 or an invalid normal count as error 1).
 #include "Common/NeighborGrid.h"
 #include "Common/Parallel.h"
 #include "Surface/CloudNormals.h"
 #include "Surface/SurfaceNormals.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -54,14 +58,17 @@ double Uniform(std::int64_t i, std::uint64_t seed)
   return (static_cast<double>(x >> 11) + 0.5) / static_cast<double>(1ULL << 53);
 }
 
-std::vector<double> ScanCloud(std::int64_t count)
+std::vector<double> ScanCloud(
+  std::int64_t count, double noiseFraction, std::vector<double>& exact, std::int64_t& sphereCount)
 {
   const double pi = 3.141592653589793238462643383279502884;
   const double R = 1.0, r = 0.25, rs = 0.5;
   const double sphereArea = 4 * pi * rs * rs, torusArea = 4 * pi * pi * R * r;
   const std::int64_t onSphere = std::llround(count * sphereArea / (sphereArea + torusArea));
-  const double sigma = 0.001 * std::sqrt(2.5 * 2.5 + 2.5 * 2.5 + 0.5 * 0.5);
+  const double sigma = noiseFraction * std::sqrt(2.5 * 2.5 + 2.5 * 2.5 + 0.5 * 0.5);
   std::vector<double> xyz(3 * static_cast<size_t>(count));
+  exact.assign(static_cast<size_t>(count), 0.0);
+  sphereCount = onSphere;
   for (std::int64_t i = 0; i < count; ++i)
   {
     double p[3], n[3];
@@ -78,6 +85,7 @@ std::vector<double> ScanCloud(std::int64_t count)
       {
         p[a] = rs * n[a];
       }
+      exact[i] = 1.0 / rs;
     }
     else
     {
@@ -96,6 +104,7 @@ std::vector<double> ScanCloud(std::int64_t count)
       p[0] = (R + r * std::cos(v)) * std::cos(theta);
       p[1] = (R + r * std::cos(v)) * std::sin(theta);
       p[2] = r * std::sin(v);
+      exact[i] = (R + 2 * r * std::cos(v)) / (2 * r * (R + r * std::cos(v)));
     }
     const double noise = sigma * std::sqrt(-2 * std::log(Uniform(i, 1))) * std::cos(2 * pi * Uniform(i, 2));
     for (int a = 0; a < 3; ++a)
@@ -117,13 +126,38 @@ std::uint64_t Digest(const std::vector<T>& values, std::uint64_t h = 14695981039
   }
   return h;
 }
+
+/// Mean, 99th percentile and largest of the relative errors |k - h| / |h| over the points [begin, end).
+void PrintErrors(const char* name, const std::vector<double>& k, const std::vector<double>& h,
+  const std::vector<unsigned char>& valid, size_t begin, size_t end)
+{
+  std::vector<double> e;
+  for (size_t i = begin; i < end; ++i)
+  {
+    e.push_back(valid[i] && k[i] != 0.0 && std::isfinite(k[i]) ? std::fabs(k[i] - h[i]) / std::fabs(h[i]) : 1.0);
+  }
+  if (e.empty())
+  {
+    return;
+  }
+  double mean = 0.0;
+  for (double x : e)
+  {
+    mean += x;
+  }
+  mean /= static_cast<double>(e.size());
+  std::sort(e.begin(), e.end());
+  std::printf("curvature error %s (%zu points): mean %.4g, p99 %.4g, max %.4g\n", name, e.size(), mean,
+    e[std::min(e.size() - 1, e.size() * 99 / 100)], e.back());
+}
 } // namespace
 
 int main(int argc, char** argv)
 {
   std::int64_t count = 1000000;
   int repeat = 1;
-  bool curvature = true, shuffle = false, full = true;
+  bool curvature = true, shuffle = false, full = true, accuracy = false;
+  double noiseFraction = 0.001;
   std::string xyzFile;
   meshfree::NormalOptions neighborhood;
   for (int a = 1; a + 1 < argc; a += 2)
@@ -157,6 +191,14 @@ int main(int argc, char** argv)
     {
       neighborhood.SupportRadius = std::atof(value.c_str());
     }
+    else if (key == "--noise")
+    {
+      noiseFraction = std::atof(value.c_str());
+    }
+    else if (key == "--accuracy")
+    {
+      accuracy = value != "0";
+    }
     else if (key == "--xyz")
     {
       xyzFile = value;
@@ -167,7 +209,8 @@ int main(int argc, char** argv)
       return 2;
     }
   }
-  std::vector<double> xyz;
+  std::vector<double> xyz, exact;
+  std::int64_t sphereCount = 0;
   if (!xyzFile.empty())
   {
     FILE* f = std::fopen(xyzFile.c_str(), "r");
@@ -186,7 +229,7 @@ int main(int argc, char** argv)
   }
   else
   {
-    xyz = ScanCloud(count);
+    xyz = ScanCloud(count, noiseFraction, exact, sphereCount);
   }
   // A fixed permutation: input position j holds point perm[j].
   std::vector<std::int64_t> perm(static_cast<size_t>(count));
@@ -265,6 +308,11 @@ int main(int argc, char** argv)
       static_cast<unsigned long long>(Digest(normals)), static_cast<unsigned long long>(Digest(curv)),
       static_cast<unsigned long long>(Digest(variation)), static_cast<unsigned long long>(Digest(confidence)),
       static_cast<unsigned long long>(Digest(radius)), static_cast<unsigned long long>(Digest(valid)));
+    if (accuracy && curvature && !exact.empty())
+    {
+      PrintErrors("sphere", curv, exact, valid, 0, static_cast<size_t>(sphereCount));
+      PrintErrors("torus", curv, exact, valid, static_cast<size_t>(sphereCount), exact.size());
+    }
     std::fflush(stdout);
   }
   return 0;

@@ -173,8 +173,30 @@ struct JetFit
   double Height = 0.0;    // signed: the jet's height at the point along the normal (the point's own offset)
   double Rms = 0.0;       // root mean square misfit of the neighbours about their jet (world units)
   double Curvature = 0.0; // the larger absolute principal curvature of the jet (1 / length)
+  // FitJet<true>: the mean curvature of the sphere-exact jet (see FitJet), positive where the surface bends away
+  // from Normal (convex for an outward normal), 1 / length; 0 when that fit failed.
+  double MeanCurvature = 0.0;
   bool Valid = false;
 };
+
+/// The mean curvature at the point of the implicit surface F = a0 + a1 u + a2 v + b3 U + b4 uv + b5 W - h = 0
+/// with U = u^2 + h^2 / 2, W = v^2 + h^2 / 2 (scaled frame coordinates), signed positive where it bends away from
+/// +h, in scaled units; evaluated at (0, 0, h0), the surface's point on the frame's axis. NaN when undefined.
+double ImplicitMeanCurvature(const double b[6])
+{
+  const double c = 0.5 * (b[3] + b[5]); // the coefficient of h^2
+  // F(0, 0, h) = a0 + c h^2 - h = 0: the root nearest 0 (stable form; no root: the point's own height).
+  const double disc = 1.0 - 4.0 * c * b[0];
+  const double h0 = disc >= 0.0 ? 2.0 * b[0] / (1.0 + std::sqrt(disc)) : b[0];
+  // The gradient g and the Hessian [[2 b3, b4, 0], [b4, 2 b5, 0], [0, 0, 2 c]] at (0, 0, h0); the mean curvature
+  // of the level set, div(g / |g|) / 2 = (|g|^2 tr H - g.H g) / (2 |g|^3) along g, which points to -h (g_h ~ -1).
+  const double g0 = b[1], g1 = b[2], g2 = 2.0 * c * h0 - 1.0;
+  const double h00 = 2.0 * b[3], h01 = b[4], h11 = 2.0 * b[5], h22 = 2.0 * c;
+  const double gg = g0 * g0 + g1 * g1 + g2 * g2;
+  const double gHg = h00 * g0 * g0 + 2.0 * h01 * g0 * g1 + h11 * g1 * g1 + h22 * g2 * g2;
+  const double div = (gg * (h00 + h11 + h22) - gHg) / (gg * std::sqrt(gg));
+  return -0.5 * div; // along +h
+}
 
 /// The sorted positions of `used` of the count entries of pos spread evenly over the list: entry m * count / used
 /// for m < used (all of them when used == count), stepped without a division per entry.
@@ -203,6 +225,13 @@ void SpreadSubset(const Index* pos, size_t count, size_t used, Index* picked)
 /// its distance to its neighbours' surface) and the normal is n - a1 t1 - a2 t2. Exact on quadrics; for a
 /// support symmetric about x the slopes are orthogonal to the quadratic terms, so noise tilts them no more
 /// than it tilts PCA's plane. Fewer than 2 neighbours per term or a degenerate jet: the PCA plane.
+/// WithCurvature: also MeanCurvature, from a second jet over the same neighbours and frame in which u^2 and v^2
+/// are completed to U = u^2 + h^2 / 2 and W = v^2 + h^2 / 2: a sphere in any frame is
+/// h = a0 + a1 u + a2 v + c (u^2 + v^2 + h^2), so that jet is exact on spheres (the plain jet's mean curvature is
+/// off by about (kappa R)^2 / 4 there), and on other surfaces as accurate as the jet to second order; its mean
+/// curvature is that of the implicit surface it defines (ImplicitMeanCurvature). The normal stays the plain jet's
+/// (the same bits either way: the second jet's sums are sums of their own).
+template <bool WithCurvature = false>
 JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double x[3], double scale)
 {
   JetFit out;
@@ -245,6 +274,8 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
     Pair s12 = { 0.0, 0.0 }, s34 = s12, s67 = s12, s89 = s12, s1011 = s12, s1213 = s12, h12 = s12, h34 = s12,
          h5h = s12;
     double s5 = 0.0, s14 = 0.0, h0 = 0.0;
+    // The curvature jet's extra sums, of q = h^2 / 2: (q, hq), (uq, vq), (uuq, uvq), (vvq, qq).
+    Pair q1 = { 0.0, 0.0 }, q2 = q1, q3 = q1, q4 = q1;
     for (size_t m = 0; m < used; ++m)
     {
       const double* p = at(m);
@@ -271,6 +302,15 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
       h34 += h * quad;
       const Pair vh = { vv, h };
       h5h += h * vh; // (h vv, h h)
+      if constexpr (WithCurvature)
+      {
+        const double q = 0.5 * h * h;
+        const Pair one_h = { 1.0, h }, vv_q = { vv, q };
+        q1 += q * one_h;
+        q2 += q * uv2;
+        q3 += q * quad;
+        q4 += q * vv_q;
+      }
       ++fitted;
     }
     su[1] = s12[0];
@@ -324,6 +364,41 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
       const double root = std::sqrt(diff * diff + a(4) * a(4));
       out.Curvature = (std::fabs(mean) + root) / scale;
       n = (n - a(1) * t1 - a(2) * t2).normalized();
+      if constexpr (WithCurvature)
+      {
+        // The basis (1, u, v, U, uv, W), U = uu + q, W = vv + q: its moments from the plain ones and q's.
+        const double sq = q1[0], shq = q1[1], suq = q2[0], svq = q2[1], suuq = q3[0], suvq = q3[1], svvq = q4[0],
+                     sqq = q4[1];
+        Eigen::Matrix<double, 6, 6> C = moments;
+        C(0, 3) += sq;
+        C(0, 5) += sq;
+        C(1, 3) += suq;
+        C(1, 5) += suq;
+        C(2, 3) += svq;
+        C(2, 5) += svq;
+        C(3, 3) += 2.0 * suuq + sqq;
+        C(3, 4) += suvq;
+        C(3, 5) += suuq + svvq + sqq;
+        C(4, 5) += suvq;
+        C(5, 5) += 2.0 * svvq + sqq;
+        for (int i = 0; i < 6; ++i)
+        {
+          for (int j = 0; j < i; ++j)
+          {
+            C(i, j) = C(j, i);
+          }
+        }
+        Eigen::Matrix<double, 6, 1> D = B, b;
+        D(3) += shq;
+        D(5) += shq;
+        double conditionC = 0.0;
+        if (SolveMoment<6>(C, D, b, false, conditionC) && b.allFinite())
+        {
+          const double k = ImplicitMeanCurvature(b.data()) / scale;
+          // Along the jet's normal (n - a1 t1 - a2 t2 lies on +h's side).
+          out.MeanCurvature = std::isfinite(k) ? k : 0.0;
+        }
+      }
     }
   }
   if (!jet)
@@ -429,8 +504,9 @@ bool NearestOfList(const double* sorted, const Index* pos, const double* r2, siz
 /// lost 7 degrees of mean accuracy without this; 0.1 rad cost the 20k-point cube's edges half their gain). (Refitting the point's own jet over the
 /// neighbours near that plane was measured worse: at the noise's scale the band takes in the other side.)
 /// rms and height are per sorted position: the jets' misfit and the point's height over its jet.
-void SharpFeatures(
-  const NeighborGrid& grid, NormalField& field, const std::vector<double>& rms, const std::vector<double>& height)
+/// meanCurvature: field.MeanCurvature follows the normal (the donor's, or the small jet's).
+void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vector<double>& rms,
+  const std::vector<double>& height, bool meanCurvature)
 {
   const double* sorted = grid.SortedPoints();
   const std::vector<Index>& order = grid.SortedOrder();
@@ -439,6 +515,7 @@ void SharpFeatures(
   // The replaced normals, applied after the pass (it reads the first ones).
   std::vector<double> replaced(static_cast<size_t>(3 * nv), 0.0);
   std::vector<unsigned char> changed(static_cast<size_t>(nv), 0);
+  std::vector<double> replacedCurvature(meanCurvature ? static_cast<size_t>(nv) : 0, 0.0);
   struct Buffers
   {
     std::vector<Index> Positions;
@@ -490,6 +567,10 @@ void SharpFeatures(
       if (best >= 0)
       {
         std::copy(&field.Normals[3 * order[best]], &field.Normals[3 * order[best]] + 3, &replaced[3 * s]);
+        if (meanCurvature)
+        {
+          replacedCurvature[s] = field.MeanCurvature[order[best]];
+        }
         changed[s] = 1;
         continue;
       }
@@ -499,10 +580,16 @@ void SharpFeatures(
       if (small < radius)
       {
         grid.FindWithinRadiusPositions(x, small, mine.Positions, mine.Dist2);
-        const JetFit fit = FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, small);
+        const JetFit fit = meanCurvature
+          ? FitJet<true>(sorted, mine.Positions.data(), mine.Positions.size(), x, small)
+          : FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, small);
         if (fit.Valid)
         {
           std::copy(fit.Normal, fit.Normal + 3, &replaced[3 * s]);
+          if (meanCurvature)
+          {
+            replacedCurvature[s] = fit.MeanCurvature;
+          }
           changed[s] = 1;
         }
       }
@@ -513,6 +600,10 @@ void SharpFeatures(
     if (changed[s])
     {
       std::copy(&replaced[3 * s], &replaced[3 * s] + 3, &field.Normals[3 * order[s]]);
+      if (meanCurvature)
+      {
+        field.MeanCurvature[order[s]] = replacedCurvature[s];
+      }
     }
   }
 }
@@ -737,6 +828,7 @@ bool EstimateNormals(
   field.Outlier.assign(static_cast<size_t>(n), 0);
   field.OutlierCount = 0;
   field.SurfaceVariation.assign(static_cast<size_t>(n), 0.0);
+  field.MeanCurvature.assign(options.MeanCurvature ? static_cast<size_t>(n) : 0, 0.0);
   field.Valid.assign(static_cast<size_t>(n), 0);
   field.Graph.assign(static_cast<size_t>(n * degree), -1);
   field.GraphDegree = degree;
@@ -864,11 +956,16 @@ bool EstimateNormals(
             pos.resize(kept);
             r2.resize(kept);
           }
-          const JetFit fit = FitJet(sorted, pos.data(), pos.size(), x, radius);
+          const JetFit fit = options.MeanCurvature ? FitJet<true>(sorted, pos.data(), pos.size(), x, radius)
+                                                   : FitJet(sorted, pos.data(), pos.size(), x, radius);
           if (!fit.Valid)
           {
             ++failed;
             continue;
+          }
+          if (options.MeanCurvature)
+          {
+            field.MeanCurvature[id] = fit.MeanCurvature;
           }
           for (int a = 0; a < 3; ++a)
           {
@@ -914,7 +1011,7 @@ bool EstimateNormals(
   field.InvalidCount = invalid;
   if (!aborted && !fixed && options.AdaptToNoise && options.WideNormals)
   {
-    SharpFeatures(grid, field, rms, height);
+    SharpFeatures(grid, field, rms, height, options.MeanCurvature);
     aborted = progress && !progress(1.0);
   }
   if (!aborted)

@@ -29,6 +29,12 @@
  * CloudScale::Noise and ::Radius (the noise radius with TiltTolerance, from the PCA spread) size the implicit
  * fits (FitSupports) as before, and the outliers' residual is measured at that smaller radius.
  *
+ * MeanCurvature (NormalOptions::MeanCurvature, for CloudNormals.h's Curvature): each jet is fitted a second time
+ * over the same neighbours and frame with u^2 and v^2 completed to u^2 + h^2 / 2 and v^2 + h^2 / 2 (a sphere in any
+ * frame is h = a0 + a1 u + a2 v + c (u^2 + v^2 + h^2): exact on spheres, where the plain jet's mean curvature is
+ * off by about (kappa R)^2 / 4), and the mean curvature of that implicit surface at the point is kept, signed
+ * along the normal as estimated. Its sums are sums of their own: the normals are the same bits either way.
+ *
  * Order independence: every neighbour choice breaks distance ties by position (NeighborGrid::NeighborBefore)
  * and every sum runs in the grid's cell order: a permuted input gives the same bits.
  *
@@ -63,6 +69,8 @@ struct NormalOptions
                                 // (Meshless Surface: wide jets take in both sides of parts thinner than them)
   double TiltTolerance = 0.05;  // radians: the implicit fits' noise radius (CloudScale::Radius)
   int GraphDegree = 8;          // nearest neighbours kept for the orientation graph
+  bool MeanCurvature = false;   // NormalField::MeanCurvature from each normal's jet (a second, sphere-exact jet
+                                // over the same neighbours; the normals are the same bits either way)
 };
 
 /// The cloud's sampling scale, from a sample of its points (medians).
@@ -82,6 +90,9 @@ struct NormalField
   std::vector<double> Radii;            // neighbourhood radius used at each point: max(r_k, NormalRadius)
   std::vector<double> NeighborDistance; // r_k: distance to the NeighborCount-th nearest other point
   std::vector<double> SurfaceVariation; // l0 / (l0 + l1 + l2)
+  std::vector<double> MeanCurvature;    // NormalOptions::MeanCurvature only (else empty): the mean curvature of
+                                        // the point's sphere-exact jet, 1 / length, positive where the surface
+                                        // bends away from Normals as estimated (before OrientNormals); 0 if none
   std::vector<double> Residual;         // distance from the point to its neighbours' jet (at max(r_k, Radius))
   std::vector<unsigned char> Outlier;   // residual > max(6 x median residual, 5 % of r_k): left out of fits
   std::vector<unsigned char> Valid;
