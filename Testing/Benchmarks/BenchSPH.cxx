@@ -2,6 +2,10 @@
 // particles) at 16k, 65k and 262k particles. Usage: BenchSPH [seconds of simulated time per size, default 0.01]
 // Threads: all the CPUs, or MESHFREE_NUM_THREADS (OMP_NUM_THREADS is honoured too).
 //
+// BenchSPH --solver dfsph [--sizes 65536] [seconds]: the same 3D dam breaks with the DFSPH solver at its default
+// tolerances and step rule (CFLNumber 0.25, TimeStep 1 ms), also reporting wall-clock seconds per simulated second
+// and the solves' iterations per step; --sizes picks among 16,384, 65,536 and 262,144 particles.
+//
 // BenchSPH --backend cuda [--steps N] [--sizes 65536,1048576,4194304]: the CUDA device integrator
 // (SPHFluid::SetBackend(CUDA)) beside the CPU on 3D dam breaks (double) of 65,536, 1,048,576 and 4,194,304
 // particles (blocks 64x32x32, 128x128x64, 256x128x128 at dx = 1 cm), a fixed step of 1e-4 s: N steps (default
@@ -117,6 +121,7 @@ int main(int argc, char* argv[])
   std::string backend = "cpu";
   long steps = 50;
   std::vector<long> sizes = { 65536, 1048576, 4194304 };
+  bool sizesGiven = false, dfsph = false;
   for (int k = 1; k < argc; ++k)
   {
     const std::string a = argv[k];
@@ -128,8 +133,19 @@ int main(int argc, char* argv[])
     {
       steps = std::max(1L, std::atol(argv[++k]));
     }
+    else if (a == "--solver" && k + 1 < argc)
+    {
+      const std::string solver = argv[++k];
+      if (solver != "dfsph" && solver != "wcsph")
+      {
+        std::fprintf(stderr, "BenchSPH: --solver takes wcsph or dfsph, not %s\n", solver.c_str());
+        return 2;
+      }
+      dfsph = solver == "dfsph";
+    }
     else if (a == "--sizes" && k + 1 < argc)
     {
+      sizesGiven = true;
       sizes.clear();
       for (char* p = argv[++k]; *p;)
       {
@@ -152,11 +168,21 @@ int main(int argc, char* argv[])
     return DeviceBenchmark(steps, sizes);
   }
   const int blocks[3][3] = { { 32, 16, 32 }, { 64, 32, 32 }, { 64, 64, 64 } };
-  std::printf("%s\n%10s %8s %12s %14s %12s\n", meshfree::ParallelBackend(), "particles", "steps", "seconds", "psteps/s",
-    "neighbours");
+  const char* dfsphColumns = "  wall s/sim s  density/divergence iterations per step";
+  std::printf("%s%s\n%10s %8s %12s %14s %12s%s\n", meshfree::ParallelBackend(), dfsph ? ", DFSPH" : "", "particles",
+    "steps", "seconds", "psteps/s", "neighbours", dfsph ? dfsphColumns : "");
   for (const auto& b : blocks)
   {
+    const long count = static_cast<long>(b[0]) * b[1] * b[2];
+    if (sizesGiven && std::find(sizes.begin(), sizes.end(), count) == sizes.end())
+    {
+      continue;
+    }
     meshfree::SPHParameters p;
+    if (dfsph)
+    {
+      p.Solver = meshfree::SPHSolver::DFSPH;
+    }
     const double dx = 0.01;
     p.Dimension = 3;
     p.ParticleSpacing = dx;
@@ -173,6 +199,7 @@ int main(int argc, char* argv[])
     meshfree::SPHState state = solver.InitialState();
     solver.Advance(state, 0.2 * span); // warm up: buffers grown, flow started
     const long first = state.Steps;
+    const double firstTime = state.Time;
     const auto start = std::chrono::steady_clock::now();
     solver.Advance(state, 1.2 * span);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -182,8 +209,19 @@ int main(int argc, char* argv[])
     {
       neighbours += c;
     }
-    std::printf("%10ld %8ld %12.3f %14.4g %12.1f\n", static_cast<long>(state.Size()), steps, seconds,
+    std::printf("%10ld %8ld %12.3f %14.4g %12.1f", static_cast<long>(state.Size()), steps, seconds,
       static_cast<double>(steps) * state.Size() / seconds, neighbours / state.Size());
+    if (dfsph)
+    {
+      std::printf("  %12.1f  %.2f / %.2f", seconds / (state.Time - firstTime),
+        static_cast<double>(state.Report.DensityIterations) / std::max(1L, state.Report.Steps),
+        static_cast<double>(state.Report.DivergenceIterations) / std::max(1L, state.Report.Steps));
+    }
+    std::printf("\n");
+  }
+  if (dfsph)
+  {
+    return 0;
   }
   {
     meshfree::SPHParameters p;

@@ -311,6 +311,8 @@ private:
     bool& last);
   std::vector<double> PairCoefficient, WallCoefficient; // m GradientNorm shape(r) of every fluid and wall pair
   std::vector<double> Alpha, Kappa, KappaOverRho, OldCompression, OldVelocity, Smoothed;
+  std::vector<double> SolveResidual, SolveDirection, SolvePreconditioned, SolveProduct, SolveVelocity; // the CG's
+  std::vector<char> SolveFree;
   void SmoothStiffness(const SPHState& state, const std::vector<double>& in, std::vector<double>& out) const;
   double LatticeFactorSum = 0.0; // |sum G|^2 + sum |G|^2 of a lattice particle far from walls, for the alpha cutoff
   long UnconvergedStepCount = 0;
