@@ -107,8 +107,8 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     tier.Radius = bounds[t];
     // Index order within cells is the main grid's sorted order here, itself by position: still order independent.
     tier.Grid.SetCellsByPosition(false);
-    // Cells as wide as the query (the automatic size fills the bounding box: a scan's surface crosses few, crowded
-    // cells, and the distance filter then saw about ten candidates per neighbour).
+    // The grid's automatic cell size (about 8 points a cell): cells as wide as the tier's query radius measured no
+    // faster (1M-point scan-like cloud, 2026-12-03: 10.7-10.8 s against 10.9 s for the whole surface).
     tier.Grid.Build(coordinates[t].data(), static_cast<Index>(positions[t].size()));
     const std::vector<Index>& order = tier.Grid.SortedOrder();
     tier.Positions.resize(order.size());
