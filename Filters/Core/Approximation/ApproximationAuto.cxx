@@ -420,8 +420,25 @@ bool Approximator::AutoSampledLeaveOneOut(
     coarseCounts[a] = std::max<Index>(1, static_cast<Index>(std::floor(extent / coarse)));
   }
   const Index samples = coarseCounts[0] * coarseCounts[1] * coarseCounts[2];
+  // The samples' positions: the coarse nodes' centres.
   double origin[3];
   this->PUOrigin(origin);
+  std::vector<double> centres(3 * static_cast<size_t>(samples));
+  for (Index node = 0; node < samples; ++node)
+  {
+    const Index index[3] = { node % coarseCounts[0], (node / coarseCounts[0]) % coarseCounts[1],
+      node / (coarseCounts[0] * coarseCounts[1]) };
+    double* x = &centres[3 * node];
+    std::copy(origin, origin + 3, x);
+    for (int a = 0; a < D; ++a)
+    {
+      const double u = umin[a] + (static_cast<double>(index[a]) + 0.5) * coarse;
+      for (int b = 0; b < 3; ++b)
+      {
+        x[b] += u * this->Frame.Axes[a][b];
+      }
+    }
+  }
   // Each sample's neighbourhood: this part's own valid points within rho, its nearest `need` of them (the union
   // over the parts holds the cloud's nearest `need`); rho is a ball holding about 4 x need points at the cloud's
   // mean density (the cover ball R holds about NeighborCount).
@@ -434,18 +451,7 @@ bool Approximator::AutoSampledLeaveOneOut(
   std::vector<std::pair<double, Index>> near;
   for (Index node = 0; node < samples; ++node)
   {
-    const Index index[3] = { node % coarseCounts[0], (node / coarseCounts[0]) % coarseCounts[1],
-      node / (coarseCounts[0] * coarseCounts[1]) };
-    double x[3] = { origin[0], origin[1], origin[2] };
-    for (int a = 0; a < D; ++a)
-    {
-      const double u = umin[a] + (static_cast<double>(index[a]) + 0.5) * coarse;
-      for (int b = 0; b < 3; ++b)
-      {
-        x[b] += u * this->Frame.Axes[a][b];
-      }
-    }
-    this->Points.FindWithinRadius(x, rho, s.Ids, &s.Dist2);
+    this->Points.FindWithinRadius(&centres[3 * node], rho, s.Ids, &s.Dist2);
     near.clear();
     for (size_t j = 0; j < s.Ids.size(); ++j)
     {
@@ -480,22 +486,6 @@ bool Approximator::AutoSampledLeaveOneOut(
   // values (nothing depends on which part held a point, nor on the input's order).
   const Index records = static_cast<Index>(all.size() / stride);
   std::vector<double> dist2(static_cast<size_t>(records));
-  std::vector<double> centres(3 * static_cast<size_t>(samples));
-  for (Index node = 0; node < samples; ++node)
-  {
-    const Index index[3] = { node % coarseCounts[0], (node / coarseCounts[0]) % coarseCounts[1],
-      node / (coarseCounts[0] * coarseCounts[1]) };
-    double* x = &centres[3 * node];
-    std::copy(origin, origin + 3, x);
-    for (int a = 0; a < D; ++a)
-    {
-      const double u = umin[a] + (static_cast<double>(index[a]) + 0.5) * coarse;
-      for (int b = 0; b < 3; ++b)
-      {
-        x[b] += u * this->Frame.Axes[a][b];
-      }
-    }
-  }
   for (Index r = 0; r < records; ++r)
   {
     const double* rec = &all[stride * r];
