@@ -274,6 +274,9 @@ int vtkMeshFreeHalo::Exchange(vtkPointSet* local, const double region[6], double
   }
   const int size = controller->GetNumberOfProcesses();
   const int rank = controller->GetLocalProcessId();
+  this->Sent.assign(size, std::vector<vtkIdType>());
+  this->Received.assign(size, std::vector<vtkIdType>());
+  std::vector<int> sender; // per received message: the partner
 
   // Every rank's request: its box and radius.
   double mine[7];
@@ -313,6 +316,7 @@ int vtkMeshFreeHalo::Exchange(vtkPointSet* local, const double region[6], double
         }
       }
     }
+    this->Sent[partner].assign(selected->begin(), selected->end());
     vtkNew<vtkPolyData> message;
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
@@ -335,6 +339,7 @@ int vtkMeshFreeHalo::Exchange(vtkPointSet* local, const double region[6], double
     if (incoming->GetNumberOfPoints() > 0)
     {
       received.push_back(incoming);
+      sender.push_back(partner);
     }
   }
 
@@ -373,10 +378,15 @@ int vtkMeshFreeHalo::Exchange(vtkPointSet* local, const double region[6], double
     from[b] = vtkSmartPointer<vtkIdList>::New();
     to[b] = vtkSmartPointer<vtkIdList>::New();
   }
+  for (size_t b = 0; b < received.size(); ++b)
+  {
+    this->Received[sender[b]].assign(received[b]->GetNumberOfPoints(), -1);
+  }
   for (size_t g = 0; g < ghosts.size(); ++g)
   {
     from[ghosts[g].Block]->InsertNextId(ghosts[g].Index);
     to[ghosts[g].Block]->InsertNextId(nOwned + static_cast<vtkIdType>(g));
+    this->Received[sender[ghosts[g].Block]][ghosts[g].Index] = nOwned + static_cast<vtkIdType>(g);
   }
   auto cloud = vtkSmartPointer<vtkPolyData>::New();
   vtkNew<vtkPoints> points;
@@ -429,6 +439,77 @@ int vtkMeshFreeHalo::Exchange(vtkPointSet* local, const double region[6], double
   out->AddArray(ghost);
   this->Output = cloud;
   return status;
+}
+
+int vtkMeshFreeHalo::UpdateHalo(vtkDataArray* values)
+{
+  vtkMultiProcessController* controller = this->Controller;
+  if (!vtkMeshFreeHalo::IsDistributed(controller))
+  {
+    return 1;
+  }
+  const int size = controller->GetNumberOfProcesses();
+  const int rank = controller->GetLocalProcessId();
+  vtkDoubleArray* array = vtkDoubleArray::SafeDownCast(values);
+  const vtkIdType total = this->Output ? this->Output->GetNumberOfPoints() : 0;
+  const bool usable = array && array->GetNumberOfTuples() == total &&
+    static_cast<int>(this->Sent.size()) == size && static_cast<int>(this->Received.size()) == size;
+  if (!usable)
+  {
+    vtkErrorMacro("UpdateHalo needs a double array with one tuple per point of the last exchange's output.");
+  }
+  // Every rank takes part in every message the plan has, whatever its own input (zeros where unusable).
+  const int components = array ? array->GetNumberOfComponents() : 1;
+  int widest = components;
+  controller->AllReduce(&components, &widest, 1, vtkCommunicator::MAX_OP);
+  std::vector<double> outgoing, incoming;
+  const int rounds = size + (size % 2) - 1;
+  for (int round = 0; round < rounds; ++round)
+  {
+    const int partner = TournamentPartner(rank, round, size);
+    if (partner < 0 || static_cast<int>(this->Sent.size()) != size)
+    {
+      continue;
+    }
+    const std::vector<vtkIdType>& sent = this->Sent[partner];
+    const std::vector<vtkIdType>& into = this->Received[partner];
+    outgoing.assign(sent.size() * widest, 0.0);
+    for (size_t j = 0; usable && components == widest && j < sent.size(); ++j)
+    {
+      array->GetTypedTuple(sent[j], &outgoing[j * widest]);
+    }
+    incoming.assign(into.size() * widest, 0.0);
+    auto send = [&]() {
+      if (!outgoing.empty())
+      {
+        controller->Send(outgoing.data(), static_cast<vtkIdType>(outgoing.size()), partner, HaloTag + 1);
+      }
+    };
+    auto receive = [&]() {
+      if (!incoming.empty())
+      {
+        controller->Receive(incoming.data(), static_cast<vtkIdType>(incoming.size()), partner, HaloTag + 1);
+      }
+    };
+    if (rank < partner)
+    {
+      send();
+      receive();
+    }
+    else
+    {
+      receive();
+      send();
+    }
+    for (size_t j = 0; usable && components == widest && j < into.size(); ++j)
+    {
+      if (into[j] >= 0)
+      {
+        array->SetTypedTuple(into[j], &incoming[j * widest]);
+      }
+    }
+  }
+  return usable && components == widest ? 1 : 0;
 }
 
 int vtkMeshFreeHalo::ExchangeForKNearest(vtkPointSet* local, const double* queries, vtkIdType numberOfQueries, int k,

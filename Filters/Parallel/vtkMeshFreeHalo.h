@@ -45,6 +45,9 @@
 #include "vtkObject.h"
 #include "vtkSmartPointer.h" // for the output
 
+#include <vector> // the exchange plan
+
+class vtkDataArray;
 class vtkIdTypeArray;
 class vtkMultiProcessController;
 class vtkPointSet;
@@ -94,6 +97,15 @@ public:
   int ExchangeForKNearest(vtkPointSet* local, const double* queries, vtkIdType numberOfQueries, int k,
     double minimumRadius = 0.0, double radiusFactor = 1.0);
 
+  /**
+   * Collective. After an Exchange(): `values` has one tuple per output point (owned points first, then the halo);
+   * every halo point's tuple is replaced by its owner's tuple of the owner's own `values` (what the owner
+   * computed for it), through the same pairs of ranks as the exchange. A point array that the ranks update for
+   * their own points this way reads the same everywhere. Double arrays only. Returns 0 on bad input (after
+   * taking part in every communication).
+   */
+  int UpdateHalo(vtkDataArray* values);
+
   ///@{
   /**
    * Results of the last exchange: the local + halo cloud, how many of its points are this rank's own (the
@@ -142,6 +154,10 @@ private:
   vtkIdType NumberOfGlobalPoints = 0;
   double Radius = 0.0;
   int NumberOfRounds = 0;
+  // The last exchange's plan, per partner rank: the owned points sent, and the output positions of the points
+  // received (in the message's order).
+  std::vector<std::vector<vtkIdType>> Sent;
+  std::vector<std::vector<vtkIdType>> Received;
 };
 
 #endif

@@ -17,13 +17,17 @@
 #include "vtkPoints.h"
 #include "vtkSmartPointer.h"
 
+#include "vtkMeshFreeHaloDistribution.h"
 #include "vtkMeshFreePieces.h"
+#include "vtkPolyData.h"
 
+#include "Common/NeighborGrid.h"
 #include "Common/Statistics.h"
 #include "Surface/CloudNormals.h"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -39,19 +43,143 @@ const char* OrientationName(int orientation)
   return orientation >= 0 && orientation < 4 ? names[orientation] : "?";
 }
 
-/// Median of the values whose mask is set (0 when none is).
-double MaskedMedian(const std::vector<double>& values, const std::vector<unsigned char>& mask)
+/// Median of the first n values whose mask is set (0 when none is), over every rank's.
+double MaskedMedian(vtkMultiProcessController* controller, const std::vector<double>& values,
+  const std::vector<unsigned char>& mask, vtkIdType n)
 {
   std::vector<double> kept;
-  for (size_t i = 0; i < values.size() && i < mask.size(); ++i)
+  for (size_t i = 0; i < values.size() && i < mask.size() && static_cast<vtkIdType>(i) < n; ++i)
   {
     if (mask[i])
     {
       kept.push_back(values[i]);
     }
   }
-  return meshfree::Median(std::move(kept));
+  if (!vtkMeshFreeHalo::IsDistributed(controller))
+  {
+    return meshfree::Median(std::move(kept));
+  }
+  // A small gather: the reported median only.
+  return meshfree::Median(vtkMeshFreePieces::AllGather(controller, kept));
 }
+
+/// The halo's first radius: this many times the distance to the k-th nearest point (below).
+constexpr double HaloNeighborhoods = 8.0;
+
+/// The median distance from up to 256 of the n points to their k-th nearest among them (a rank's own points:
+/// an upper bound of the whole cloud's); 0 when there are too few.
+double LocalNeighborDistance(const double* xyz, vtkIdType n, int k)
+{
+  meshfree::NeighborGrid grid;
+  grid.Build(xyz, n);
+  const meshfree::Index nv = grid.NumberOfValidPoints();
+  if (nv <= k)
+  {
+    return 0.0;
+  }
+  std::vector<meshfree::Index> ids;
+  std::vector<double> dist2, kth;
+  const meshfree::Index samples = std::min<meshfree::Index>(nv, 256);
+  for (meshfree::Index j = 0; j < samples; ++j)
+  {
+    if (grid.FindKNearest(grid.SortedPoints() + 3 * (j * nv / samples), k + 1, ids, dist2) == k + 1)
+    {
+      kth.push_back(std::sqrt(dist2.back()));
+    }
+  }
+  return meshfree::Median(std::move(kth));
+}
+/// Distributed (collective): this rank's points with a halo from the others (vtkMeshFreeHalo), the core computing
+/// its own points' results (their first `input` points), with the same bits as a serial run. referenceNormals
+/// (reference orientation) is given or not on every rank alike (an empty rank passes an empty array). `held` gets
+/// the number of points this rank computed over.
+bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* controller, vtkPointSet* input,
+  vtkDataArray* referenceNormals, meshfree::CloudNormalsOptions& options, meshfree::CloudNormalsResult& result,
+  vtkIdType& held, double& haloRadius, int& attempts)
+{
+  // This rank's points (and reference normals), with the input's global ids when it has them.
+  const vtkIdType n = input->GetNumberOfPoints();
+  vtkNew<vtkPolyData> mine;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    points->SetPoint(i, input->GetPoint(i));
+  }
+  mine->SetPoints(points);
+  if (referenceNormals)
+  {
+    vtkNew<vtkDoubleArray> reference;
+    reference->SetNumberOfComponents(3);
+    reference->DeepCopy(referenceNormals);
+    reference->SetName(kNormals);
+    mine->GetPointData()->AddArray(reference);
+  }
+  if (vtkDataArray* ids = input->GetPointData()->GetGlobalIds())
+  {
+    mine->GetPointData()->SetGlobalIds(ids);
+  }
+  // The whole cloud's frame, and the region this rank's halo grows from (its points' box).
+  const double* xyz = vtkDoubleArray::SafeDownCast(points->GetData())->GetPointer(0);
+  double region[6], frame[6];
+  vtkMeshFreeHalo::FiniteBounds(xyz, n, region);
+  vtkMeshFreeHalo::GlobalBounds(controller, region, frame);
+  vtkIdType finite = 0;
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    finite += std::isfinite(xyz[3 * i]) && std::isfinite(xyz[3 * i + 1]) && std::isfinite(xyz[3 * i + 2]) ? 1 : 0;
+  }
+  options.Framed = true;
+  std::copy(frame, frame + 6, options.FrameBounds);
+  options.FramePoints = vtkMeshFreeHalo::GlobalSum(controller, finite);
+
+  // The halo: first as wide as a few neighbourhoods, then as wide as the computation reports it reached (its
+  // Shortfall; the last attempt takes every point, which is always enough).
+  const int k = std::max(3, options.Neighborhood.NeighborCount);
+  double radius = HaloNeighborhoods * vtkMeshFreeHalo::GlobalMax(controller, LocalNeighborDistance(xyz, n, k));
+  if (options.Neighborhood.SupportRadius > 0.0)
+  {
+    radius = std::max(radius, 2.0 * options.Neighborhood.SupportRadius);
+  }
+  vtkNew<vtkMeshFreeHalo> halo;
+  halo->SetController(controller);
+  for (int attempt = 0; attempt < 4; ++attempt)
+  {
+    if (attempt == 3 || !std::isfinite(radius))
+    {
+      radius = std::numeric_limits<double>::infinity();
+    }
+    halo->Exchange(mine, region, radius);
+    haloRadius = radius;
+    attempts = attempt + 1;
+    vtkMeshFreeHaloDistribution processes(controller, halo, region, radius);
+    options.Neighborhood.Processes = &processes;
+    vtkPolyData* cloud = halo->GetOutput();
+    held = cloud->GetNumberOfPoints();
+    const double* local = vtkDoubleArray::SafeDownCast(cloud->GetPoints()->GetData())->GetPointer(0);
+    vtkDoubleArray* reference =
+      referenceNormals ? vtkDoubleArray::SafeDownCast(cloud->GetPointData()->GetArray(kNormals)) : nullptr;
+    const bool done = meshfree::ComputeCloudNormals(local, held, reference ? reference->GetPointer(0) : nullptr,
+      options, result, attempt == 0 ? vtkMeshFreeFilterSupport::Progress(self) : meshfree::ProgressCallback());
+    options.Neighborhood.Processes = nullptr;
+    const bool aborted = vtkMeshFreeHalo::GlobalMax(controller, done && !result.Aborted ? 0.0 : 1.0) > 0.0;
+    const double shortfall = vtkMeshFreeHalo::GlobalMax(controller, result.Shortfall);
+    vtkDebugWithObjectMacro(self, "Halo radius " << radius << ": " << held << " points held, shortfall " << shortfall << ".");
+    if (aborted)
+    {
+      result.Aborted = true;
+      return false;
+    }
+    if (!(shortfall > 0.0) || std::isinf(radius))
+    {
+      return true;
+    }
+    radius = std::max(radius + 1.25 * shortfall, 1.5 * radius);
+  }
+  return true;
+}
+
 } // namespace
 
 vtkMeshlessNormals::vtkMeshlessNormals() = default;
@@ -104,37 +232,12 @@ int vtkMeshlessNormals::RequestData(
     return 1;
   }
   const bool useReference = haveNormals && (this->Orientation == AUTO || this->Orientation == INPUT_NORMALS);
-  const int width = useReference ? 6 : 3;
-  std::vector<double> rows(static_cast<size_t>(width) * n);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    input->GetPoint(i, &rows[static_cast<size_t>(width) * i]);
-    if (useReference)
-    {
-      inputNormals->GetTuple(i, &rows[static_cast<size_t>(width) * i + 3]);
-    }
-  }
-  // Distributed: the whole cloud on every rank, in global id order (the orientation is global; see the class doc).
-  const vtkMeshFreePieces::GatheredCloud cloud = vtkMeshFreePieces::GatherCloud(controller, input, rows, width);
-  rows.clear();
-  const vtkIdType count = cloud.Count;
-  std::vector<double> xyz(3 * static_cast<size_t>(count));
-  std::vector<double> reference(useReference ? 3 * static_cast<size_t>(count) : 0);
-  for (vtkIdType i = 0; i < count; ++i)
-  {
-    std::copy_n(&cloud.Rows[static_cast<size_t>(width) * i], 3, &xyz[3 * i]);
-    if (useReference)
-    {
-      std::copy_n(&cloud.Rows[static_cast<size_t>(width) * i + 3], 3, &reference[3 * i]);
-    }
-  }
   output->ShallowCopy(input);
-  if (count == 0 && reporter)
+  if (total == 0 && reporter)
   {
     vtkWarningMacro("The input has no points: nothing to compute.");
   }
 
-  // Compute.
   meshfree::CloudNormalsOptions options;
   options.Neighborhood.NeighborCount = this->NeighborCount;
   options.Neighborhood.SupportRadius = this->SupportRadius;
@@ -146,14 +249,41 @@ int vtkMeshlessNormals::RequestData(
   options.ProjectPoints = this->ProjectPoints;
   options.ProjectionIterations = this->ProjectionIterations;
   meshfree::CloudNormalsResult result;
-  const bool done = meshfree::ComputeCloudNormals(xyz.data(), count, useReference ? reference.data() : nullptr,
-    options, result, vtkMeshFreeFilterSupport::Progress(this));
+  bool done = false;
+  vtkIdType held = n; // the points this rank computed over (own and halo), the halo's radius, the attempts
+  double haloRadius = 0.0;
+  int attempts = 0;
+  if (!distributed)
+  {
+    std::vector<double> xyz(3 * static_cast<size_t>(n)), reference(useReference ? 3 * static_cast<size_t>(n) : 0);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      input->GetPoint(i, &xyz[3 * i]);
+      if (useReference)
+      {
+        inputNormals->GetTuple(i, &reference[3 * i]);
+      }
+    }
+    done = meshfree::ComputeCloudNormals(xyz.data(), n, useReference ? reference.data() : nullptr, options, result,
+      vtkMeshFreeFilterSupport::Progress(this));
+  }
+  else
+  {
+    vtkNew<vtkDoubleArray> none; // an empty piece's reference: the same orientation mode as the other ranks'
+    none->SetNumberOfComponents(3);
+    vtkDataArray* reference = useReference ? (inputNormals ? inputNormals : none.GetPointer()) : nullptr;
+    done = ComputeDistributed(this, controller, input, reference, options, result, held, haloRadius, attempts);
+  }
   if (!done || result.Aborted)
   {
     output->Initialize();
     vtkWarningMacro("Aborted: the output is empty.");
     return 1;
   }
+  const vtkIdType count = total;
+  result.Invalid = vtkMeshFreeHalo::GlobalSum(controller, result.Invalid);
+  result.Outliers = vtkMeshFreeHalo::GlobalSum(controller, result.Outliers);
+  result.Duplicates = vtkMeshFreeHalo::GlobalSum(controller, result.Duplicates);
   if (result.Invalid > 0 && reporter)
   {
     vtkWarningMacro(<< result.Invalid << " of " << count
@@ -166,17 +296,13 @@ int vtkMeshlessNormals::RequestData(
                                << " points projected; " << result.Outliers << " outliers left out of the fits, "
                                << result.Duplicates << " exact duplicates merged.");
 
-  // Wrap the results of this rank's own points (all of them when not distributed).
-  const std::vector<vtkIdType>& own = cloud.Own;
-  auto ownArray = [&own, n](const char* name, int components, const std::vector<double>& values) {
+  // Wrap the results of this rank's own points: the first n of its local cloud, in input order.
+  auto ownArray = [n](const char* name, int components, const std::vector<double>& values) {
     auto array = vtkSmartPointer<vtkDoubleArray>::New();
     array->SetName(name);
     array->SetNumberOfComponents(components);
     array->SetNumberOfTuples(n);
-    for (vtkIdType i = 0; i < n; ++i)
-    {
-      std::copy_n(&values[static_cast<size_t>(own[i]) * components], components, array->GetPointer(components * i));
-    }
+    std::copy_n(values.data(), static_cast<size_t>(components) * n, array->GetPointer(0));
     return array;
   };
   if (this->ProjectPoints && n > 0)
@@ -186,7 +312,7 @@ int vtkMeshlessNormals::RequestData(
     moved->SetNumberOfPoints(n);
     for (vtkIdType i = 0; i < n; ++i)
     {
-      moved->SetPoint(i, &result.Points[3 * own[i]]);
+      moved->SetPoint(i, &result.Points[3 * i]);
     }
     output->SetPoints(moved);
   }
@@ -203,7 +329,7 @@ int vtkMeshlessNormals::RequestData(
   mask->SetNumberOfTuples(n);
   for (vtkIdType i = 0; i < n; ++i)
   {
-    mask->SetValue(i, static_cast<char>(result.Valid[own[i]] ? 1 : 0));
+    mask->SetValue(i, static_cast<char>(result.Valid[i] ? 1 : 0));
   }
   pd->AddArray(mask);
   pd->SetActiveScalars(this->ComputeCurvature ? "Curvature" : "OrientationConfidence");
@@ -211,11 +337,24 @@ int vtkMeshlessNormals::RequestData(
   // Field data: of the whole cloud, the same on every rank.
   vtkFieldData* fd = output->GetFieldData();
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "NoiseEstimate", result.Scale.Noise);
-  vtkMeshFreeFilterSupport::AddFieldValue(fd, "SupportRadius", MaskedMedian(result.Radius, result.Valid));
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "SupportRadius", MaskedMedian(controller, result.Radius, result.Valid, n));
   vtkNew<vtkIdTypeArray> ambiguous;
   ambiguous->SetName("AmbiguousOrientations");
   ambiguous->InsertNextValue(static_cast<vtkIdType>(result.Orientation.Ambiguous));
   fd->AddArray(ambiguous);
+  if (distributed)
+  {
+    // This rank's own, per rank: how many points it computed over (its piece and its halo).
+    vtkNew<vtkIdTypeArray> local;
+    local->SetName("LocalCloudPoints");
+    local->InsertNextValue(held);
+    fd->AddArray(local);
+    vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", haloRadius);
+    vtkNew<vtkIdTypeArray> rounds;
+    rounds->SetName("HaloAttempts");
+    rounds->InsertNextValue(attempts);
+    fd->AddArray(rounds);
+  }
   return 1;
 }
 

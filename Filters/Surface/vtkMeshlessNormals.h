@@ -30,16 +30,17 @@
  * neighbourhood radius), `AmbiguousOrientations` (points with OrientationConfidence < 0.5).
  *
  * Under MPI (pvbatch, pvserver: each rank's input is piece = rank of N) each rank outputs its own points, in the
- * order of its piece, with the arrays and field data that a serial run gives them, bit for bit. The estimation
- * has global steps: the propagated orientation (a minimum spanning tree over the whole cloud's neighbour graph,
- * then each connected piece turned outward as a whole), the noise and scale estimate (a sample of the whole
- * cloud), the outlier threshold and fit supports (medians over all points) and the merging of duplicates. So that
- * every one of them is the serial one, the filter is not distributed yet: every rank gathers the whole cloud
- * (coordinates, and the input's Normals when they orient the result: 24 or 48 bytes per point; an all-gather,
- * in which ranks with empty pieces take part), puts it in global id order (the GlobalIds attribute, else the
- * rank-by-rank concatenation, the serial order of a cloud split by index) and runs the serial estimation on
- * it, keeping its own points' results. Each rank thus spends the serial run's time and memory. An input that every
- * rank holds whole (piece 0 of 1 on each rank) is computed locally, without communication.
+ * order of its piece, with the arrays and field data that a serial run gives them, bit for bit. The computation is
+ * distributed: each rank holds its piece and a halo (vtkMeshFreeHalo: the other ranks' points within a radius of
+ * its piece's box, first 8 neighbourhood radii, widened and recomputed when the estimation reports it reached
+ * farther), estimates its own points, and shares what the neighbours' computations read through halo updates;
+ * the global steps are distributed too: the scale estimate's sample (chosen by a hash of the positions),
+ * the medians (exact selections over the ranks), the orientation (blocks oriented where their points are, then
+ * the same small graph of blocks solved on every rank) and the duplicates (each owned where its smallest global
+ * id is). Memory per rank: its piece and halo (field data `LocalCloudPoints`, `HaloRadius`, `HaloAttempts`, per
+ * rank); pieces compact in space (slabs, RedistributeDataSet) keep the halo a band along their faces, pieces
+ * split by index span the whole cloud and hold all of it. An input that every rank holds whole (piece 0 of 1 on
+ * each rank) is computed locally, without communication.
  *
  * @sa vtkMeshlessSurface vtkPCANormalEstimation
  */

@@ -4,14 +4,16 @@
 The cloud: a sphere (radius 0.5) inside a torus (R = 1, r = 0.25), points spread evenly over their area (a Fibonacci
 spiral on the sphere, an R2 sequence mapped to equal area on the torus), each moved along its normal by Gaussian
 noise of 0.1 % of the bounding-box diagonal (sigma = 0.0024), as a range scanner's depth noise. Point i depends on i
-alone, so each rank generates only its own index share (with GlobalIds) and every split gives the same cloud.
+alone, so every split gives the same cloud (with GlobalIds): --split index gives rank p the index range
+[pN/P, (p+1)N/P) (spread over the cloud), --split slab (default) the p-th slab of N/P points along x (each rank makes
+the whole cloud and keeps its slab: compact pieces, as RedistributeDataSet makes them).
 
 Per case (Meshless Normals with Orientation 'Propagation' (consistent across each piece) and its other defaults; Meshless Surface, MLS, its defaults): the
 filter's wall time (the slowest rank, from a barrier to a barrier), where it went (the surface's field data
 SetupSeconds, ContourSeconds, ProjectionSeconds, ApproximationSeconds), each rank's peak resident memory and its
 growth during the filter (peak minus the resident memory once the cloud is loaded), the points a rank owns and the
-points it held while computing (field data `GatheredPoints` or `HaloPoints` when the filter reports them; a filter
-that gathers the cloud on every rank holds all of it). Serial is 1 rank x 2 threads; ranks are oversubscribed on a
+points it held while computing (field data `LocalCloudPoints` of a distributed filter: its piece and halo;
+`GatheredPoints` when reported; a filter that gathers the cloud on every rank holds all of it). Serial is 1 rank x 2 threads; ranks are oversubscribed on a
 2-core machine, so time is not the figure there: memory and points per rank are.
 
   python3 Testing/Benchmarks/bench_scale.py [--plugin path/to/MeshFree.so] [--points 1000000 10000000]
@@ -37,11 +39,13 @@ import numpy as np
 from vtkmodules.util import numpy_support as ns
 from vtkmodules.vtkCommonCore import vtkPoints, VTK_ID_TYPE
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as sddp
-count = {count}
+count, split = {count}, '{split}'
 info = self.GetOutputInformation(0)
 piece = info.Get(sddp.UPDATE_PIECE_NUMBER()) if info.Has(sddp.UPDATE_PIECE_NUMBER()) else 0
 pieces = info.Get(sddp.UPDATE_NUMBER_OF_PIECES()) if info.Has(sddp.UPDATE_NUMBER_OF_PIECES()) else 1
 lo, hi = piece * count // pieces, (piece + 1) * count // pieces
+if split == 'slab' and pieces > 1:
+    lo, hi = 0, count  # every point made, then this piece's slab along x kept (below)
 R, r, rs = 1.0, 0.25, 0.5
 area_sphere, area_torus = 4 * np.pi * rs * rs, 4 * np.pi * np.pi * R * r
 ns_count = int(round(count * area_sphere / (area_sphere + area_torus)))
@@ -73,6 +77,11 @@ def uniform(seed):  # splitmix64 of (i, seed): independent of the split
     return ((x >> np.uint64(11)).astype(np.float64) + 0.5) / float(1 << 53)
 noise = 0.001 * np.sqrt(2.5 ** 2 + 2.5 ** 2 + 0.5 ** 2) * np.sqrt(-2 * np.log(uniform(1))) * np.cos(2 * np.pi * uniform(2))
 xyz += noise[:, None] * nrm
+if split == 'slab' and pieces > 1:  # slabs of equal counts along x: compact pieces, as RedistributeDataSet gives
+    order = np.argsort(xyz[:, 0], kind='stable')
+    keep = np.sort(order[piece * count // pieces:(piece + 1) * count // pieces])
+    xyz, i = xyz[keep], i[keep]
+    del order, nrm
 out = self.GetPolyDataOutput()
 pts = vtkPoints()
 pts.SetData(ns.numpy_to_vtk(np.ascontiguousarray(xyz), deep=1))
@@ -95,7 +104,7 @@ def worker(args):
 
     simple, controller, rank, ranks, plugin = start_worker(args.plugin)
     cloud = simple.ProgrammableSource(OutputDataSetType="vtkPolyData", ScriptRequestInformation=INFO_SCRIPT,
-                                      Script=CLOUD_SCRIPT.format(count=args.points))
+                                      Script=CLOUD_SCRIPT.format(count=args.points, split=args.split))
     cloud.UpdatePipeline()
     owned = cloud.GetClientSideObject().GetOutputDataObject(0).GetNumberOfPoints()
     if args.case == "normals":
@@ -112,7 +121,8 @@ def worker(args):
     elapsed = time.perf_counter() - start
     out = algorithm.GetClientSideObject().GetOutputDataObject(0)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    held = field_value(out, "GatheredPoints")
+    held = field_value(out, "LocalCloudPoints")  # a distributed filter: its piece and halo
+    held = field_value(out, "GatheredPoints") if held is None else held
     if held is None:
         halo = field_value(out, "HaloPoints")
         held = owned + halo if halo is not None else float(args.points)  # today's filters gather the cloud
@@ -129,6 +139,9 @@ def main():
     ap.add_argument("--points", type=int, nargs="+", default=[1000000, 10000000])
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 4])
     ap.add_argument("--cases", nargs="+", default=["normals", "surface"], choices=["normals", "surface"])
+    ap.add_argument("--split", default="slab", choices=["slab", "index"],
+                    help="pieces: slabs of equal counts along x (compact, as after RedistributeDataSet; default) or "
+                         "index ranges (the generator's order: spread over the cloud)")
     ap.add_argument("--serial-only-above", type=int, default=2000000,
                     help="clouds larger than this run serially only (default 2,000,000: 24 GB machines)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
@@ -152,7 +165,7 @@ def main():
                 out = tempfile.mkdtemp(prefix="bench_scale_")
                 command = ["mpiexec", "--oversubscribe", "-n", str(ranks), "pvbatch", "--symmetric",
                            os.path.abspath(__file__), "--worker", "--plugin", args.plugin, "--points", str(points),
-                           "--out", out, "--case", case]
+                           "--out", out, "--case", case, "--split", args.split]
                 result = subprocess.run(command, env=run_env, capture_output=True, text=True)
                 rows = []
                 for name in sorted(glob.glob(os.path.join(out, "rank*.json"))):

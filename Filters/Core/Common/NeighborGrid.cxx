@@ -185,6 +185,19 @@ void NeighborGrid::SetPointsPerCell(double pointsPerCell)
   this->PointsPerCell = pointsPerCell > 0.0 && std::isfinite(pointsPerCell) ? pointsPerCell : 8.0;
 }
 
+void NeighborGrid::SetFrame(const double bounds[6], Index validPoints)
+{
+  std::copy(bounds, bounds + 6, this->FrameBounds);
+  this->FramePoints = std::max<Index>(validPoints, 1);
+  this->Framed = bounds[0] <= bounds[1] && bounds[2] <= bounds[3] && bounds[4] <= bounds[5];
+}
+
+void NeighborGrid::GetFrame(double bounds[6], Index& validPoints) const
+{
+  std::copy(this->FrameUsedBounds, this->FrameUsedBounds + 6, bounds);
+  validPoints = this->FrameUsedPoints;
+}
+
 bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
 {
   if (xyz == nullptr || n < 0)
@@ -200,6 +213,11 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   std::fill(this->Extent, this->Extent + 3, 0.0);
   std::fill(this->GridDims, this->GridDims + 3, Index(1));
   this->Size = this->InverseSize = 1.0;
+  this->FrameUsedPoints = this->Framed ? this->FramePoints : 0;
+  if (this->Framed)
+  {
+    std::copy(this->FrameBounds, this->FrameBounds + 6, this->FrameUsedBounds);
+  }
   if (n == 0)
   {
     return false;
@@ -269,10 +287,16 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   }
   for (int a = 0; a < 3; ++a)
   {
-    this->Origin[a] = lo[a];
-    this->Extent[a] = hi[a] - lo[a];
+    this->Origin[a] = this->Framed ? this->FrameBounds[2 * a] : lo[a];
+    this->Extent[a] = this->Framed ? this->FrameBounds[2 * a + 1] - this->FrameBounds[2 * a] : hi[a] - lo[a];
   }
-  this->ChooseGrid(cellSize, m);
+  for (int a = 0; a < 3; ++a)
+  {
+    this->FrameUsedBounds[2 * a] = this->Framed ? this->FrameBounds[2 * a] : lo[a];
+    this->FrameUsedBounds[2 * a + 1] = this->Framed ? this->FrameBounds[2 * a + 1] : hi[a];
+  }
+  this->FrameUsedPoints = this->Framed ? this->FramePoints : m;
+  this->ChooseGrid(cellSize, this->FrameUsedPoints);
 
   // Compact Morton code of a cell = OR of one table entry per axis: bit l of the x, y and z cell
   // coordinates go to consecutive key bits (x lowest), skipping axes that have run out of bits. This

@@ -120,6 +120,14 @@ public:
   /// Whether the next Build() sorts the points of each cell by position (default) or keeps them in original
   /// index order (see the class comment).
   void SetCellsByPosition(bool byPosition) { this->CellsByPosition = byPosition; }
+  /// A frame for the next Build()s: cells laid over `bounds` (xmin, xmax, ymin, ymax, zmin, zmax, holding every
+  /// point given) and sized for `validPoints`, instead of the points' own bounds and count. A grid over part of a
+  /// cloud (a process' piece and halo) framed by the whole cloud's bounds and count has the whole cloud's cells
+  /// and Morton order, so its queries list the points they find exactly as the whole cloud's grid does.
+  /// ClearFrame() returns to the points' own; GetFrame() gives the last Build()'s (bounds and valid points).
+  void SetFrame(const double bounds[6], Index validPoints);
+  void ClearFrame() { this->Framed = false; }
+  void GetFrame(double bounds[6], Index& validPoints) const;
   bool GetCellsByPosition() const { return this->CellsByPosition; }
   ///@}
 
@@ -246,6 +254,11 @@ private:
 
   double PointsPerCell = 8.0;
   bool CellsByPosition = true;
+  bool Framed = false;
+  double FrameBounds[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 };
+  Index FramePoints = 0;
+  Index FrameUsedPoints = 0; // the valid points the last Build() sized its cells for, and its bounds
+  double FrameUsedBounds[6] = { 1.0, 0.0, 1.0, 0.0, 1.0, 0.0 };
   Index NumberOfInputPoints = 0;
   double Origin[3] = { 0.0, 0.0, 0.0 }; // minimum of the valid points' bounds
   double Extent[3] = { 0.0, 0.0, 0.0 };

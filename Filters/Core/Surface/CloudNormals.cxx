@@ -6,6 +6,7 @@
 #include "Surface/UniqueCloud.h"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <cstdint>
 
@@ -46,8 +47,75 @@ void ExpandDuplicates(const CloudNormalsResult& distinct, const UniqueCloud& uni
   result.Projected = distinct.Projected;
   result.Outliers = distinct.Outliers;
   result.Duplicates = unique.Duplicates;
+  result.Shortfall = distinct.Shortfall;
   result.Aborted = distinct.Aborted;
 }
+/// A distributed cloud's distinct points (UniqueCloud): each is owned where its member with the smallest key is,
+/// and its halo values are that member's owner's.
+class DistinctDistribution : public Distribution
+{
+public:
+  DistinctDistribution(const Distribution& base, const UniqueCloud& unique, Index n)
+    : Base(base)
+    , Unique(unique)
+    , Representative(unique.Points.size() / 3, -1)
+  {
+    for (Index i = 0; i < n; ++i)
+    {
+      const Index u = unique.Unique[i];
+      if (u >= 0 && (this->Representative[u] < 0 || base.Key(i) < base.Key(this->Representative[u])))
+      {
+        this->Representative[u] = i;
+      }
+    }
+  }
+  bool Owned(Index u) const override { return this->Base.Owned(this->Representative[u]); }
+  std::int64_t Key(Index u) const override { return this->Base.Key(this->Representative[u]); }
+  void Sum(double* values, Index count) const override { this->Base.Sum(values, count); }
+  void Sum(std::int64_t* values, Index count) const override { this->Base.Sum(values, count); }
+  void Max(double* values, Index count) const override { this->Base.Max(values, count); }
+  void Gather(const std::vector<double>& mine, std::vector<double>& all) const override
+  {
+    this->Base.Gather(mine, all);
+  }
+  double Complete(const double x[3]) const override { return this->Base.Complete(x); }
+  void UpdateHalo(double* values, int components) const override
+  {
+    const Index n = static_cast<Index>(this->Unique.Unique.size());
+    std::vector<double> expanded(static_cast<size_t>(n * components), 0.0);
+    for (Index i = 0; i < n; ++i)
+    {
+      const Index u = this->Unique.Unique[i];
+      if (u >= 0)
+      {
+        std::copy_n(values + u * components, components, &expanded[static_cast<size_t>(i * components)]);
+      }
+    }
+    this->Base.UpdateHalo(expanded.data(), components);
+    for (size_t u = 0; u < this->Representative.size(); ++u)
+    {
+      std::copy_n(&expanded[static_cast<size_t>(this->Representative[u] * components)], components,
+        values + u * components);
+    }
+  }
+  /// This process' own input points that are not their distinct point's representative.
+  Index OwnDuplicates() const
+  {
+    Index count = 0;
+    for (size_t i = 0; i < this->Unique.Unique.size(); ++i)
+    {
+      const Index u = this->Unique.Unique[i];
+      count += u >= 0 && this->Base.Owned(static_cast<Index>(i)) && this->Representative[u] != static_cast<Index>(i);
+    }
+    return count;
+  }
+
+private:
+  const Distribution& Base;
+  const UniqueCloud& Unique;
+  std::vector<Index> Representative;
+};
+
 /// Rounds of averaging of the jets' curvature over the orientation graph (see SmoothJetCurvature).
 constexpr int CurvatureRounds = 24;
 /// Graph neighbours whose normals differ by more than acos(CurvatureAgreement) (a crease, the other side of a thin
@@ -65,7 +133,7 @@ constexpr double CurvatureAgreement = 0.5;
 /// ahead at about 0.4 CPU s per 1M points; exact data pay a little smoothing: torus 0.2 -> 0.5 % mean error). In the grid's order
 /// (neighbours near in memory), the graph translated to it once. 0 where invalid.
 void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, const std::vector<double>& unoriented,
-  std::vector<double>& curvature)
+  const Distribution* d, std::vector<double>& curvature)
 {
   const Index n = static_cast<Index>(field.Valid.size());
   const std::vector<Index>& order = grid.SortedOrder();
@@ -124,6 +192,22 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
       }
     });
     k.swap(next);
+    if (d)
+    {
+      // The halo's values of this round from their owners (they average over neighbours beyond the halo).
+      std::vector<double>& perPoint = next; // free until the next round
+      perPoint.assign(static_cast<size_t>(n), 0.0);
+      for (Index s = 0; s < nv; ++s)
+      {
+        perPoint[order[s]] = k[s];
+      }
+      d->UpdateHalo(perPoint.data(), 1);
+      for (Index s = 0; s < nv; ++s)
+      {
+        k[s] = perPoint[order[s]];
+      }
+      next.assign(static_cast<size_t>(nv), 0.0);
+    }
   }
   curvature.assign(static_cast<size_t>(n), 0.0);
   for (Index s = 0; s < nv; ++s)
@@ -136,21 +220,67 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
 bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNormals, const CloudNormalsOptions& options,
   CloudNormalsResult& result, const ProgressCallback& progress)
 {
+  const Distribution* d = options.Neighborhood.Processes;
   result = CloudNormalsResult();
   result.Points.assign(xyz, xyz + 3 * std::max<Index>(n, 0));
   NeighborGrid grid;
+  if (options.Framed)
+  {
+    grid.SetFrame(options.FrameBounds, options.FramePoints);
+  }
   grid.Build(xyz, n);
   UniqueCloud unique;
-  if (MergeDuplicates(grid, xyz, referenceNormals, unique))
+  // Whether any process has duplicates: then all compute on their distinct points (collectively).
+  const bool merged = MergeDuplicates(grid, xyz, referenceNormals, unique);
+  if (GlobalMax(d, merged ? 1.0 : 0.0) > 0.0)
   {
-    // Computed on the distinct points; every duplicate gets its representative's results.
+    if (!merged)
+    {
+      unique = UniqueCloud();
+      unique.Points.assign(xyz, xyz + 3 * std::max<Index>(n, 0));
+      if (referenceNormals)
+      {
+        unique.Normals.assign(referenceNormals, referenceNormals + 3 * std::max<Index>(n, 0));
+      }
+      unique.Unique.resize(static_cast<size_t>(std::max<Index>(n, 0)));
+      for (Index i = 0; i < n; ++i)
+      {
+        const double* x = xyz + 3 * i;
+        unique.Unique[i] = std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]) ? i : -1;
+      }
+    }
+    // Computed on the distinct points, in the same frame; every duplicate gets its representative's results.
+    CloudNormalsOptions distinctOptions = options;
+    distinctOptions.Framed = true;
+    grid.GetFrame(distinctOptions.FrameBounds, distinctOptions.FramePoints);
+    std::unique_ptr<DistinctDistribution> processes;
+    if (d)
+    {
+      processes.reset(new DistinctDistribution(*d, unique, n));
+      distinctOptions.Neighborhood.Processes = processes.get();
+      unique.Duplicates = processes->OwnDuplicates();
+    }
     CloudNormalsResult distinct;
     const bool done = ComputeCloudNormals(unique.Points.data(), static_cast<Index>(unique.Points.size() / 3),
-      referenceNormals ? unique.Normals.data() : nullptr, options, distinct, progress);
+      referenceNormals ? unique.Normals.data() : nullptr, distinctOptions, distinct, progress);
     ExpandDuplicates(distinct, unique, n, result);
+    if (d)
+    {
+      result.Invalid = 0;
+      for (Index i = 0; i < n; ++i)
+      {
+        result.Invalid += d->Owned(i) && !result.Valid[i] ? 1 : 0;
+      }
+    }
     return done;
   }
   NormalField field;
+  // Aborting is local: a distributed computation goes on through every collective step and is discarded at the end.
+  bool aborted = false;
+  auto stop = [&progress, &aborted](double f) {
+    aborted = aborted || (progress && !progress(f));
+    return aborted;
+  };
   const auto stage = [&progress](double begin, double end) -> ProgressCallback {
     if (!progress)
     {
@@ -165,7 +295,8 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
   neighborhood.MeanCurvature = jetCurvature;
   const bool estimated = EstimateNormals(grid, neighborhood, field, stage(0.0, 0.5));
   result.Scale = field.Scale;
-  if (!estimated && progress && !progress(0.5))
+  result.Shortfall = field.Shortfall;
+  if (!estimated && stop(0.5) && !d)
   {
     result.Aborted = true;
     return false;
@@ -174,6 +305,7 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
   orientation.Mode = options.Orientation;
   std::copy(options.Viewpoint, options.Viewpoint + 3, orientation.Viewpoint);
   orientation.Reference = referenceNormals;
+  orientation.Processes = d;
   if (orientation.Mode == OrientationMode::Reference && !referenceNormals)
   {
     orientation.Mode = OrientationMode::Propagation;
@@ -185,12 +317,13 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
     unoriented = field.Normals;
   }
   result.Orientation = OrientNormals(grid, field, orientation, result.Confidence);
+  result.Shortfall = std::max(result.Shortfall, result.Orientation.Shortfall);
   result.Curvature.assign(static_cast<size_t>(n), 0.0);
   if (jetCurvature)
   {
-    SmoothJetCurvature(grid, field, unoriented, result.Curvature);
+    SmoothJetCurvature(grid, field, unoriented, d, result.Curvature);
   }
-  if (progress && !progress(0.6))
+  if (stop(0.6) && !d)
   {
     result.Aborted = true;
     return false;
@@ -203,15 +336,22 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
   if (fits)
   {
     const std::vector<double> support = FitSupports(field, options.SupportScale, options.NoiseScale,
-      options.Neighborhood.SupportRadius > 0.0, median);
-    surface.SetCloud(grid, field.Normals.data(), support.data());
+      options.Neighborhood.SupportRadius > 0.0, median, d);
+    surface.SetCloud(grid, field.Normals.data(), support.data(), d);
+    // A projection moves a point at most one support and queries one support around it there.
+    for (Index i = 0; d && i < n; ++i)
+    {
+      if (field.Valid[i] && d->Owned(i))
+      {
+        result.Shortfall = std::max(result.Shortfall, Shortfall(d, xyz + 3 * i, 2.0 * 3.0 * median));
+      }
+    }
   }
   // In the grid's (Morton) order: neighbouring points share their neighbours in cache (at 1M points twice as
   // fast as the input's order when that is random).
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
   const Index chunk = 65536;
-  bool aborted = false;
   Index projected = 0;
   PerThread<FieldScratch> scratch;
   for (Index begin = 0; fits && begin < nv && !aborted; begin += chunk)
@@ -224,7 +364,7 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
         for (Index s = begin + b0; s < begin + b1; ++s)
         {
           const Index i = order[s];
-          if (!field.Valid[i])
+          if (!field.Valid[i] || (d && !d->Owned(i)))
           {
             continue;
           }
@@ -249,7 +389,15 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
         return count;
       },
       [](Index a, Index b) { return a + b; });
-    aborted = progress && !progress(0.6 + 0.4 * static_cast<double>(end) / static_cast<double>(nv));
+    stop(0.6 + 0.4 * static_cast<double>(end) / static_cast<double>(nv));
+  }
+  if (d)
+  {
+    // The halo's final values from their owners (a distinct point's duplicates may be another process' own).
+    UpdateHalo(d, result.Points, 3);
+    UpdateHalo(d, field.Normals, 3);
+    UpdateHalo(d, result.Curvature);
+    UpdateHalo(d, result.Confidence);
   }
   result.Projected = projected;
   result.Normals = std::move(field.Normals);

@@ -46,6 +46,11 @@ struct CloudNormalsOptions
   int ProjectionIterations = 2;
   double SupportScale = 2.0; // the projection's sphere fits: as SurfaceOptions
   double NoiseScale = 2.0;
+  // The grid's frame (NeighborGrid::SetFrame): a distributed cloud's process lays its piece and halo over the whole
+  // cloud's cells (bounds and number of valid points), so that its queries list points as a serial run does.
+  bool Framed = false;
+  double FrameBounds[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 };
+  Index FramePoints = 0;
 };
 
 struct CloudNormalsResult
@@ -63,6 +68,8 @@ struct CloudNormalsResult
   Index Projected = 0;
   Index Outliers = 0;                   // flagged by SurfaceNormals.h: kept, but left out of the fits
   Index Duplicates = 0;                 // exact duplicates: computed once, copied (UniqueCloud.h)
+  double Shortfall = -HUGE_VAL;         // distributed: how far beyond the complete part of the local cloud a
+                                        // query reached (Distribution.h; > 0: widen the halo by it and rerun)
   bool Aborted = false;
 };
 

@@ -2,7 +2,11 @@
 // Minimum-spanning-tree propagation of normal orientation (NormalOrientation.h).
 #include "Surface/NormalOrientation.h"
 
+#include "Common/Parallel.h"
+
 #include <algorithm>
+#include <array>
+#include <tuple>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -56,46 +60,195 @@ inline double Dot(const double* a, const double* b)
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/// The neighbour graph of the valid points, outliers left out (a random normal in the tree would flip the
-/// whole subtree beyond it), made symmetric, in compressed rows indexed by sorted position.
-void SymmetricGraph(const NormalField& field, const std::vector<Index>& order, const std::vector<std::int32_t>& rank,
-  std::vector<Index>& offsets, std::vector<std::int32_t>& adjacent)
+/// A piece of the orientation: component c of the block with key Block (BlockKey).
+struct Node
 {
-  const int k = field.GraphDegree;
-  const Index nv = static_cast<Index>(order.size());
-  offsets.assign(static_cast<size_t>(nv + 1), 0);
-  auto edges = [&](auto&& visit) {
-    for (Index s = 0; s < nv; ++s)
+  std::uint64_t Block = 0;
+  std::int64_t Component = 0;
+  bool operator<(const Node& o) const { return std::tie(this->Block, this->Component) < std::tie(o.Block, o.Component); }
+  bool operator==(const Node& o) const { return this->Block == o.Block && this->Component == o.Component; }
+};
+
+/// Blocks: cubes of edge `edge` anchored at the frame's minimum (the whole cloud's, NeighborGrid::SetFrame), keyed
+/// by their three 21-bit coordinates.
+struct Blocks
+{
+  double Origin[3] = { 0.0, 0.0, 0.0 };
+  double Inverse = 1.0;
+  std::uint64_t Key(const double* x) const
+  {
+    std::uint64_t key = 0;
+    for (int a = 0; a < 3; ++a)
     {
-      const Index id = order[s];
-      if (!field.Valid[id] || field.Outlier[id])
+      const double t = (x[a] - this->Origin[a]) * this->Inverse;
+      const std::uint64_t c = t > 0.0 ? std::min<std::uint64_t>(static_cast<std::uint64_t>(t), (1u << 21) - 1) : 0;
+      key = (key << 21) | c;
+    }
+    return key;
+  }
+};
+
+/// Votes (c . 2^24, rounded: integer sums are exact in any order) of the graph edges between two nodes.
+constexpr double VoteScale = 16777216.0;
+
+/// Union-find with the parity of each element relative to its set's root (Kruskal over the nodes).
+class ParityForest
+{
+public:
+  explicit ParityForest(size_t n)
+    : Parent(n)
+    , Parity(n, 0)
+  {
+    for (size_t i = 0; i < n; ++i)
+    {
+      this->Parent[i] = i;
+    }
+  }
+  /// The root of i, and i's parity relative to it.
+  size_t Find(size_t i, int& parity)
+  {
+    parity = 0;
+    size_t r = i;
+    while (this->Parent[r] != r)
+    {
+      parity ^= this->Parity[r];
+      r = this->Parent[r];
+    }
+    // Path compression, keeping parities relative to the root.
+    int p = parity;
+    while (this->Parent[i] != r && this->Parent[i] != i)
+    {
+      const size_t next = this->Parent[i];
+      const int own = this->Parity[i];
+      this->Parent[i] = r;
+      this->Parity[i] = p;
+      p ^= own;
+      i = next;
+    }
+    return r;
+  }
+  /// Joins the sets of a and b so that parity(a) ^ parity(b) == relation; false when already joined. The smaller
+  /// root stays the root (the result depends on the edges only, not on their order of equal weight).
+  bool Join(size_t a, size_t b, int relation)
+  {
+    int pa, pb;
+    const size_t ra = this->Find(a, pa);
+    const size_t rb = this->Find(b, pb);
+    if (ra == rb)
+    {
+      return false;
+    }
+    const size_t root = std::min(ra, rb), child = std::max(ra, rb);
+    this->Parent[child] = root;
+    this->Parity[child] = pa ^ pb ^ relation;
+    return true;
+  }
+
+private:
+  std::vector<size_t> Parent;
+  std::vector<int> Parity;
+};
+
+/// Blocks of the propagation: this many times the median distance to the NeighborCount-th neighbour (about ten
+/// spacings: a few hundred points of a surface per block).
+constexpr double BlockNeighborhoods = 4.0;
+
+/// Node entries (node, sums) -> one per node, sums added (in gathered order: process by process), every
+/// process' included; nodes sorted.
+void ReduceNodes(const Distribution* d, std::vector<std::pair<Node, std::array<double, 8>>>& entries,
+  std::vector<Node>& nodes, std::vector<std::array<double, 8>>& sums)
+{
+  auto reduce = [&]() {
+    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    nodes.clear();
+    sums.clear();
+    for (const auto& e : entries)
+    {
+      if (nodes.empty() || !(nodes.back() == e.first))
       {
+        nodes.push_back(e.first);
+        sums.push_back(e.second);
         continue;
       }
-      for (int j = 0; j < k; ++j)
+      for (int c = 0; c < 8; ++c)
       {
-        const std::int32_t v = field.Graph[static_cast<size_t>(id) * k + j];
-        if (v >= 0 && field.Valid[v] && !field.Outlier[v])
-        {
-          visit(static_cast<std::int32_t>(s), rank[v]);
-        }
+        sums.back()[c] += e.second[c];
       }
     }
   };
-  edges([&](std::int32_t a, std::int32_t b) {
-    ++offsets[a + 1];
-    ++offsets[b + 1];
-  });
-  for (Index s = 0; s < nv; ++s)
+  reduce();
+  if (!d)
   {
-    offsets[s + 1] += offsets[s];
+    return;
   }
-  adjacent.resize(static_cast<size_t>(offsets[nv]));
-  std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
-  edges([&](std::int32_t a, std::int32_t b) {
-    adjacent[fill[a]++] = b;
-    adjacent[fill[b]++] = a;
-  });
+  std::vector<double> mine, all;
+  for (size_t m = 0; m < nodes.size(); ++m)
+  {
+    mine.insert(mine.end(), { static_cast<double>(nodes[m].Block >> 32),
+                              static_cast<double>(nodes[m].Block & 0xffffffffull),
+                              static_cast<double>(nodes[m].Component) });
+    mine.insert(mine.end(), sums[m].begin(), sums[m].end());
+  }
+  d->Gather(mine, all);
+  entries.clear();
+  for (size_t e = 0; e + 11 <= all.size(); e += 11)
+  {
+    const double* v = &all[e];
+    std::array<double, 8> values;
+    std::copy(v + 3, v + 11, values.begin());
+    entries.push_back({ Node{ (static_cast<std::uint64_t>(v[0]) << 32) | static_cast<std::uint64_t>(v[1]),
+                          static_cast<std::int64_t>(v[2]) },
+      values });
+  }
+  reduce();
+}
+
+/// Votes (a, b, q) -> one per pair, q added, every process' included; pairs sorted.
+void ReduceVotes(const Distribution* d, std::vector<std::tuple<Node, Node, std::int64_t>>& votes,
+  std::vector<std::tuple<Node, Node, std::int64_t>>& links)
+{
+  auto reduce = [&]() {
+    std::sort(votes.begin(), votes.end());
+    links.clear();
+    for (const auto& v : votes)
+    {
+      if (!links.empty() && std::get<0>(links.back()) == std::get<0>(v) && std::get<1>(links.back()) == std::get<1>(v))
+      {
+        std::get<2>(links.back()) += std::get<2>(v);
+      }
+      else
+      {
+        links.push_back(v);
+      }
+    }
+  };
+  reduce();
+  if (!d)
+  {
+    return;
+  }
+  std::vector<double> mine, all;
+  for (const auto& l : links)
+  {
+    const Node& a = std::get<0>(l);
+    const Node& b = std::get<1>(l);
+    mine.insert(mine.end(),
+      { static_cast<double>(a.Block >> 32), static_cast<double>(a.Block & 0xffffffffull),
+        static_cast<double>(a.Component), static_cast<double>(b.Block >> 32),
+        static_cast<double>(b.Block & 0xffffffffull), static_cast<double>(b.Component),
+        static_cast<double>(std::get<2>(l)) });
+  }
+  d->Gather(mine, all);
+  votes.clear();
+  auto node = [](const double* v) {
+    return Node{ (static_cast<std::uint64_t>(v[0]) << 32) | static_cast<std::uint64_t>(v[1]),
+      static_cast<std::int64_t>(v[2]) };
+  };
+  for (size_t e = 0; e + 7 <= all.size(); e += 7)
+  {
+    votes.emplace_back(node(&all[e]), node(&all[e + 3]), static_cast<std::int64_t>(all[e + 6]));
+  }
+  reduce();
 }
 } // namespace
 
@@ -105,6 +258,8 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   OrientationReport report;
   const Index n = static_cast<Index>(field.Valid.size());
   confidence.assign(static_cast<size_t>(n), 0.0);
+  const Distribution* d = options.Processes;
+  auto own = [d](Index i) { return !d || d->Owned(i); };
 
   if (options.Mode == OrientationMode::Reference && options.Reference)
   {
@@ -125,159 +280,354 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
         m[2] = -m[2];
       }
       confidence[i] = std::fabs(c);
-      report.Ambiguous += confidence[i] < 0.5 ? 1 : 0;
+      report.Ambiguous += confidence[i] < 0.5 && own(i) ? 1 : 0;
     }
+    report.Ambiguous = GlobalSum(d, report.Ambiguous);
     return report;
   }
 
-  // Everything in the grid's sorted order.
   const std::vector<Index>& order = grid.SortedOrder();
   const double* xyz = grid.SortedPoints();
   const Index nv = static_cast<Index>(order.size());
+  const int k = field.GraphDegree;
   std::vector<std::int32_t> rank(static_cast<size_t>(n), -1);
   std::vector<double> normals(static_cast<size_t>(3 * nv));
   std::vector<unsigned char> valid(static_cast<size_t>(nv));
+  std::vector<double> distances;
   for (Index s = 0; s < nv; ++s)
   {
-    rank[order[s]] = static_cast<std::int32_t>(s);
-    std::copy(&field.Normals[3 * order[s]], &field.Normals[3 * order[s]] + 3, &normals[3 * s]);
-    valid[s] = field.Valid[order[s]] && !field.Outlier[order[s]];
+    const Index id = order[s];
+    rank[id] = static_cast<std::int32_t>(s);
+    std::copy(&field.Normals[3 * id], &field.Normals[3 * id] + 3, &normals[3 * s]);
+    valid[s] = field.Valid[id] && !field.Outlier[id];
+    if (valid[s] && own(id))
+    {
+      distances.push_back(field.NeighborDistance[id]);
+    }
   }
-  std::vector<Index> offsets;
-  std::vector<std::int32_t> adjacent;
-  SymmetricGraph(field, order, rank, offsets, adjacent);
+
+  // The blocks: BlockNeighborhoods x the median r_k of the whole cloud, over the frame's cells.
+  double frame[6];
+  Index framePoints = 0;
+  grid.GetFrame(frame, framePoints);
+  const double extent = std::max({ frame[1] - frame[0], frame[3] - frame[2], frame[5] - frame[4], 0.0 });
+  double edge = std::max(BlockNeighborhoods * GlobalMedian(d, std::move(distances)), extent / (1 << 20));
+  if (!(edge > 0.0) || !std::isfinite(edge))
+  {
+    edge = extent > 0.0 && std::isfinite(extent) ? extent : 1.0;
+  }
+  Blocks blocks;
+  for (int a = 0; a < 3; ++a)
+  {
+    blocks.Origin[a] = std::isfinite(frame[2 * a]) ? frame[2 * a] : 0.0;
+  }
+  blocks.Inverse = 1.0 / edge;
+  std::vector<std::uint64_t> blockOf(static_cast<size_t>(nv), 0);
+  std::vector<std::uint64_t> wanted; // the blocks holding an own point: oriented here
+  for (Index s = 0; s < nv; ++s)
+  {
+    if (valid[s])
+    {
+      blockOf[s] = blocks.Key(xyz + 3 * s);
+      if (own(order[s]))
+      {
+        wanted.push_back(blockOf[s]);
+        // The whole block lies within its diagonal of the point.
+        report.Shortfall = std::max(report.Shortfall, Shortfall(d, xyz + 3 * s, edge * std::sqrt(3.0)));
+      }
+    }
+  }
+  std::sort(wanted.begin(), wanted.end());
+  wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+  // Their points, block by block, each block's in sorted order.
+  std::vector<std::pair<std::uint64_t, std::int32_t>> members;
+  std::vector<unsigned char> inBlock(static_cast<size_t>(nv), 0);
+  for (Index s = 0; s < nv; ++s)
+  {
+    if (valid[s] && std::binary_search(wanted.begin(), wanted.end(), blockOf[s]))
+    {
+      members.emplace_back(blockOf[s], static_cast<std::int32_t>(s));
+      inBlock[s] = 1;
+    }
+  }
+  std::sort(members.begin(), members.end());
+  std::vector<size_t> blockBegin(wanted.size() + 1, members.size());
+  for (size_t m = members.size(); m-- > 0;)
+  {
+    blockBegin[std::lower_bound(wanted.begin(), wanted.end(), members[m].first) - wanted.begin()] = m;
+  }
+
+  // The graph's edges inside each block, symmetric, in compressed rows by sorted position (visited in sorted
+  // order: a block's lists are the same on every process that holds the block).
+  std::vector<Index> offsets(static_cast<size_t>(nv + 1), 0);
+  auto edges = [&](auto&& visit) {
+    for (Index s = 0; s < nv; ++s)
+    {
+      if (!inBlock[s])
+      {
+        continue;
+      }
+      const Index id = order[s];
+      for (int j = 0; j < k; ++j)
+      {
+        const std::int32_t v = field.Graph[static_cast<size_t>(id) * k + j];
+        const std::int32_t t = v >= 0 ? rank[v] : -1;
+        if (t >= 0 && inBlock[t] && blockOf[t] == blockOf[s])
+        {
+          visit(static_cast<std::int32_t>(s), t);
+        }
+      }
+    }
+  };
+  edges([&](std::int32_t a, std::int32_t b) {
+    ++offsets[a + 1];
+    ++offsets[b + 1];
+  });
+  for (Index s = 0; s < nv; ++s)
+  {
+    offsets[s + 1] += offsets[s];
+  }
+  std::vector<std::int32_t> adjacent(static_cast<size_t>(offsets[nv]));
+  {
+    std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
+    edges([&](std::int32_t a, std::int32_t b) {
+      adjacent[fill[a]++] = b;
+      adjacent[fill[b]++] = a;
+    });
+  }
+
+  // Prim's propagation inside each block (blocks in parallel): components numbered in the block from its first
+  // point in sorted order.
   std::vector<double> sortedConfidence(static_cast<size_t>(nv), 0.0);
   std::vector<unsigned char> done(static_cast<size_t>(nv), 0);
   std::vector<std::int32_t> parent(static_cast<size_t>(nv), -1);
+  std::vector<std::int64_t> component(static_cast<size_t>(nv), -1);
   std::vector<float> key(static_cast<size_t>(nv), std::numeric_limits<float>::infinity());
-  std::vector<std::int32_t> members;
-  BucketQueue heap;
-  for (Index seed = 0; seed < nv; ++seed)
+  PerThread<BucketQueue> queues;
+  ParallelFor(static_cast<Index>(wanted.size()), 1, [&](Index b0, Index b1) {
+    BucketQueue& heap = queues.Local();
+    for (Index b = b0; b < b1; ++b)
+    {
+      std::int64_t count = 0;
+      for (size_t m = blockBegin[b]; m < blockBegin[b + 1]; ++m)
+      {
+        const std::int32_t seed = members[m].second;
+        if (done[seed])
+        {
+          continue;
+        }
+        heap.Push(seed, 0.0f);
+        key[seed] = 0.0f;
+        while (!heap.Empty())
+        {
+          const std::int32_t u = heap.Pop();
+          if (done[u])
+          {
+            continue; // an entry left behind when its key was lowered
+          }
+          done[u] = 1;
+          component[u] = count;
+          double* nu = &normals[3 * u];
+          if (parent[u] >= 0)
+          {
+            const double c = Dot(nu, &normals[3 * parent[u]]);
+            if (c < 0.0)
+            {
+              nu[0] = -nu[0];
+              nu[1] = -nu[1];
+              nu[2] = -nu[2];
+            }
+            sortedConfidence[u] = std::fabs(c);
+          }
+          else
+          {
+            sortedConfidence[u] = 1.0;
+          }
+          for (Index e = offsets[u]; e < offsets[u + 1]; ++e)
+          {
+            const std::int32_t v = adjacent[e];
+            if (done[v])
+            {
+              continue;
+            }
+            const float cost = static_cast<float>(1.0 - std::fabs(Dot(nu, &normals[3 * v])));
+            if (cost < key[v])
+            {
+              key[v] = cost;
+              parent[v] = u;
+              heap.Push(v, cost);
+            }
+          }
+        }
+        ++count;
+      }
+    }
+  });
+
+  // Per point: its node (block, component) and whether the propagation turned it; the halo's from its owners.
+  std::vector<double> state(static_cast<size_t>(4 * n), 0.0);
+  for (Index s = 0; s < nv; ++s)
   {
-    if (!valid[seed] || done[seed])
+    if (component[s] >= 0)
+    {
+      double* st = &state[4 * order[s]];
+      st[0] = Dot(&normals[3 * s], &field.Normals[3 * order[s]]) < 0.0 ? -1.0 : 1.0;
+      st[1] = static_cast<double>(blockOf[s] >> 32);
+      st[2] = static_cast<double>(blockOf[s] & 0xffffffffull);
+      st[3] = static_cast<double>(component[s] + 1); // 0: none
+    }
+  }
+  UpdateHalo(d, state, 4);
+  auto nodeOf = [&state](Index id) {
+    const double* st = &state[4 * id];
+    return Node{ (static_cast<std::uint64_t>(st[1]) << 32) | static_cast<std::uint64_t>(st[2]),
+      static_cast<std::int64_t>(st[3]) - 1 };
+  };
+
+  // Each node's sums over own points (count, position relative to the blocks' origin, turned normal, n . x) and
+  // the votes of the graph's edges between nodes (|n_i . n_j| rounded to integers: exact sums in any order).
+  std::vector<std::pair<Node, std::array<double, 8>>> nodeSums;
+  std::vector<std::tuple<Node, Node, std::int64_t>> votes;
+  for (Index s = 0; s < nv; ++s)
+  {
+    const Index id = order[s];
+    if (component[s] < 0 || !own(id))
+    {
+      continue;
+    }
+    const Node a = nodeOf(id);
+    const double x[3] = { xyz[3 * s] - blocks.Origin[0], xyz[3 * s + 1] - blocks.Origin[1],
+      xyz[3 * s + 2] - blocks.Origin[2] };
+    const double* ni = &normals[3 * s];
+    nodeSums.push_back({ a, { 1.0, x[0], x[1], x[2], ni[0], ni[1], ni[2], Dot(ni, x) } });
+    for (int j = 0; j < k; ++j)
+    {
+      const std::int32_t v = field.Graph[static_cast<size_t>(id) * k + j];
+      if (v < 0 || state[4 * static_cast<size_t>(v) + 3] < 1.0)
+      {
+        continue;
+      }
+      const Node b = nodeOf(v);
+      if (b == a)
+      {
+        continue;
+      }
+      const double c = state[4 * static_cast<size_t>(v)] * Dot(ni, &field.Normals[3 * static_cast<size_t>(v)]);
+      const std::int64_t q = std::llround(c * VoteScale);
+      votes.emplace_back(std::min(a, b), std::max(a, b), q);
+    }
+  }
+  // Reduced here, then over the processes (every process gets the same node list and votes).
+  std::vector<Node> nodes;
+  std::vector<std::array<double, 8>> sums;
+  std::vector<std::tuple<Node, Node, std::int64_t>> links;
+  ReduceNodes(d, nodeSums, nodes, sums);
+  ReduceVotes(d, votes, links);
+
+  // The nodes' relative turns: a maximum spanning forest of the votes (Kruskal; the strongest agreement or
+  // disagreement first, ties by the nodes), each node's parity relative to its tree's root.
+  std::sort(links.begin(), links.end(), [](const auto& a, const auto& b) {
+    const std::int64_t wa = std::llabs(std::get<2>(a)), wb = std::llabs(std::get<2>(b));
+    return wa != wb ? wa > wb : std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
+  });
+  ParityForest forest(nodes.size());
+  auto indexOf = [&nodes](const Node& x) {
+    return static_cast<size_t>(std::lower_bound(nodes.begin(), nodes.end(), x) - nodes.begin());
+  };
+  for (const auto& link : links)
+  {
+    if (std::get<2>(link) != 0)
+    {
+      forest.Join(indexOf(std::get<0>(link)), indexOf(std::get<1>(link)), std::get<2>(link) < 0 ? 1 : 0);
+    }
+  }
+  // Each tree (a connected piece of the cloud) turned as a whole: outward, or towards the viewpoint.
+  std::vector<size_t> root(nodes.size());
+  std::vector<int> parity(nodes.size());
+  std::vector<std::array<double, 8>> pieces(nodes.size(), std::array<double, 8>{});
+  for (size_t m = 0; m < nodes.size(); ++m)
+  {
+    root[m] = forest.Find(m, parity[m]);
+    const double sign = parity[m] ? -1.0 : 1.0;
+    std::array<double, 8>& piece = pieces[root[m]];
+    for (int c = 0; c < 4; ++c)
+    {
+      piece[c] += sums[m][c];
+    }
+    for (int c = 4; c < 8; ++c)
+    {
+      piece[c] += sign * sums[m][c];
+    }
+  }
+  std::vector<unsigned char> turned(nodes.size(), 0);
+  for (size_t m = 0; m < nodes.size(); ++m)
+  {
+    if (root[m] != m)
     {
       continue;
     }
     ++report.Components;
-    members.clear();
-    heap.Push(static_cast<std::int32_t>(seed), 0.0f);
-    key[seed] = 0.0f;
-    while (!heap.Empty())
+    const std::array<double, 8>& piece = pieces[m];
+    double centre[3];
+    for (int a = 0; a < 3; ++a)
     {
-      const std::int32_t u = heap.Pop();
-      if (done[u])
-      {
-        continue; // an entry left behind when its key was lowered
-      }
-      done[u] = 1;
-      members.push_back(u);
-      double* nu = &normals[3 * u];
-      if (parent[u] >= 0)
-      {
-        const double c = Dot(nu, &normals[3 * parent[u]]);
-        if (c < 0.0)
-        {
-          nu[0] = -nu[0];
-          nu[1] = -nu[1];
-          nu[2] = -nu[2];
-        }
-        sortedConfidence[u] = std::fabs(c);
-      }
-      else
-      {
-        sortedConfidence[u] = 1.0;
-      }
-      for (Index e = offsets[u]; e < offsets[u + 1]; ++e)
-      {
-        const std::int32_t v = adjacent[e];
-        if (done[v])
-        {
-          continue;
-        }
-        const float cost = static_cast<float>(1.0 - std::fabs(Dot(nu, &normals[3 * v])));
-        if (cost < key[v])
-        {
-          key[v] = cost;
-          parent[v] = u;
-          heap.Push(v, cost);
-        }
-      }
+      centre[a] = options.Mode == OrientationMode::Viewpoint ? options.Viewpoint[a] - blocks.Origin[a]
+                                                             : piece[1 + a] / std::max(piece[0], 1.0);
     }
-    // The component as a whole: outward (or towards the viewpoint).
-    double centre[3] = { 0.0, 0.0, 0.0 };
-    if (options.Mode == OrientationMode::Viewpoint)
-    {
-      std::copy(options.Viewpoint, options.Viewpoint + 3, centre);
-    }
-    else
-    {
-      // Relative to the seed, so that clouds far from the origin keep their precision.
-      const double* o = xyz + 3 * seed;
-      for (std::int32_t m : members)
-      {
-        for (int a = 0; a < 3; ++a)
-        {
-          centre[a] += xyz[3 * m + a] - o[a];
-        }
-      }
-      for (int a = 0; a < 3; ++a)
-      {
-        centre[a] = o[a] + centre[a] / static_cast<double>(members.size());
-      }
-    }
-    double flux = 0.0;
-    for (std::int32_t m : members)
-    {
-      const double d[3] = { xyz[3 * m] - centre[0], xyz[3 * m + 1] - centre[1], xyz[3 * m + 2] - centre[2] };
-      flux += Dot(&normals[3 * m], d);
-    }
-    const bool flip = options.Mode == OrientationMode::Viewpoint ? flux > 0.0 : flux < 0.0;
-    if (flip)
-    {
-      ++report.FlippedComponents;
-      for (std::int32_t m : members)
-      {
-        for (int a = 0; a < 3; ++a)
-        {
-          normals[3 * m + a] = -normals[3 * m + a];
-        }
-      }
-    }
+    // sum_i n_i . (x_i - c) = sum n.x - c . sum n
+    const double flux = piece[7] - (centre[0] * piece[4] + centre[1] * piece[5] + centre[2] * piece[6]);
+    turned[m] = options.Mode == OrientationMode::Viewpoint ? flux > 0.0 : flux < 0.0;
+    report.FlippedComponents += turned[m];
   }
-  for (Index s = 0; s < nv; ++s)
-  {
-    const Index id = order[s];
-    std::copy(&normals[3 * s], &normals[3 * s] + 3, &field.Normals[3 * id]);
-    confidence[id] = valid[s] ? sortedConfidence[s] : 0.0;
-    report.Ambiguous += valid[s] && sortedConfidence[s] < 0.5 ? 1 : 0;
-  }
-  // Outliers follow their nearest oriented neighbour.
-  const int k = field.GraphDegree;
+
+  // The final normals: as propagated in the block, turned with its node.
   for (Index i = 0; i < n; ++i)
   {
-    if (!field.Valid[i] || !field.Outlier[i])
+    const double* st = &state[4 * i];
+    if (!(st[3] >= 1.0))
     {
       continue;
     }
-    for (int j = 0; j < k; ++j)
+    const size_t m = indexOf(nodeOf(i));
+    const double sign = st[0] * (parity[m] ? -1.0 : 1.0) * (turned[root[m]] ? -1.0 : 1.0);
+    for (int a = 0; a < 3; ++a)
     {
-      const std::int32_t v = field.Graph[static_cast<size_t>(i) * k + j];
-      if (v >= 0 && field.Valid[v] && !field.Outlier[v])
+      field.Normals[3 * i + a] *= sign;
+    }
+    confidence[i] = rank[i] >= 0 && component[rank[i]] >= 0 ? sortedConfidence[rank[i]] : 0.0;
+  }
+  // Outliers follow their nearest oriented neighbour.
+  Index ambiguous = 0;
+  for (Index i = 0; i < n; ++i)
+  {
+    if (!field.Valid[i] || !own(i))
+    {
+      continue;
+    }
+    if (field.Outlier[i])
+    {
+      for (int j = 0; j < k; ++j)
       {
-        double* m = &field.Normals[3 * i];
-        const double c = Dot(m, &field.Normals[3 * v]);
-        if (c < 0.0)
+        const std::int32_t v = field.Graph[static_cast<size_t>(i) * k + j];
+        if (v >= 0 && field.Valid[v] && !field.Outlier[v])
         {
-          m[0] = -m[0];
-          m[1] = -m[1];
-          m[2] = -m[2];
+          double* m = &field.Normals[3 * i];
+          const double c = Dot(m, &field.Normals[3 * v]);
+          if (c < 0.0)
+          {
+            m[0] = -m[0];
+            m[1] = -m[1];
+            m[2] = -m[2];
+          }
+          confidence[i] = std::fabs(c);
+          break;
         }
-        confidence[i] = std::fabs(c);
-        break;
       }
     }
-    report.Ambiguous += confidence[i] < 0.5 ? 1 : 0;
+    ambiguous += confidence[i] < 0.5 ? 1 : 0;
   }
+  UpdateHalo(d, field.Normals, 3);
+  report.Ambiguous = GlobalSum(d, ambiguous);
   return report;
 }
 

@@ -2,14 +2,25 @@
 /**
  * @brief Consistent orientation of estimated normals (NormalField from SurfaceNormals.h), in place.
  *
- * Propagation (the default; Hoppe et al. 1992): a minimum spanning tree of the symmetrised k-nearest graph
- * with edge cost 1 - |n_i . n_j| (Prim's algorithm with an indexed heap, O(E log n), memory O(n k)), grown
- * from the first point of each connected component; every point is flipped to agree with its tree parent,
- * so orientation travels across the flattest, least ambiguous edges. Each component is then turned
- * outward as a whole: sum_i n_i . (p_i - c) > 0, c its centroid (by the divergence theorem this is 3 x the
- * enclosed volume for a closed surface, so it is positive exactly when the normals point out; for an open
- * patch it picks the convex side). `Confidence` is |n_i . n_parent| (1 for the components' roots): below
- * 0.5 the orientation was ambiguous there (research/surface.md §4).
+ * Propagation (the default; Hoppe et al. 1992), in two levels so that it runs in parallel and gives the same
+ * result whatever the split of the cloud among processes:
+ * 1. Blocks: cubes of 4 x the median distance to the NeighborCount-th neighbour (about ten spacings), laid over
+ *    the grid's frame (the whole cloud's bounds). Inside each block (blocks in parallel), a minimum spanning tree
+ *    of the symmetrised k-nearest graph's edges within the block, cost 1 - |n_i . n_j| (Prim's algorithm with a
+ *    bucket queue), grown from the block's first point in the grid's order; every point is flipped to agree with
+ *    its tree parent, so orientation travels across the flattest, least ambiguous edges. Each tree is a node.
+ * 2. Nodes: every graph edge between two nodes votes n_i . n_j (rounded to 2^-24, so that the votes' sums are
+ *    exact in any order); a maximum spanning forest of the summed votes (Kruskal, strongest first, ties by the
+ *    nodes' keys) turns each node relative to its tree's root: the strongest agreement or disagreement decides,
+ *    and hundreds of edges vote across a block's face where Prim's single edge could fall on an ambiguous pair.
+ * Each connected piece (a tree of nodes) is then turned outward as a whole: sum_i n_i . (p_i - c) > 0, c its
+ * centroid (by the divergence theorem this is 3 x the enclosed volume for a closed surface, so it is positive
+ * exactly when the normals point out; for an open patch it picks the convex side). `Confidence` is
+ * |n_i . n_parent| (1 for the blocks' roots): below 0.5 the orientation was ambiguous there (research/surface.md
+ * §4). Distributed (OrientationOptions::Processes): each process orients the blocks that hold one of its own
+ * points (its halo holds the rest of them: Shortfall reports a block beyond it), the nodes' votes and sums are
+ * gathered (a few values per block), and every process solves the same node forest. Only the pieces' flux
+ * sums (decisions on their sign) depend on the summation order.
  * Viewpoint: every component is turned towards a viewpoint as a whole (sum_i n_i . (v - p_i) > 0); the
  * propagation still decides within it, so non-star-shaped objects stay consistent.
  * Reference: each normal is flipped to agree with a given normal (e.g. a scan's normals of poor quality or
@@ -37,13 +48,15 @@ struct OrientationOptions
   OrientationMode Mode = OrientationMode::Propagation;
   double Viewpoint[3] = { 0.0, 0.0, 0.0 };
   const double* Reference = nullptr; // 3 per point (Mode Reference)
+  const Distribution* Processes = nullptr; // a cloud split among processes (SurfaceNormals.h's NormalOptions)
 };
 
 struct OrientationReport
 {
   Index Components = 0;          // connected pieces of the neighbour graph
   Index FlippedComponents = 0;   // turned as a whole (outward or to the viewpoint)
-  Index Ambiguous = 0;           // valid points with Confidence < 0.5
+  Index Ambiguous = 0;           // valid points with Confidence < 0.5 (of the whole cloud)
+  double Shortfall = -HUGE_VAL;  // distributed: Shortfall() of the blocks the propagation read (<= 0: complete)
 };
 
 /// Orients field.Normals in place; `grid` is the one the field was estimated on (the propagation runs in its

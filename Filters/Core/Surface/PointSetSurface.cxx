@@ -9,8 +9,9 @@
 namespace meshfree
 {
 
-void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, const double* radii)
+void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, const double* radii, const Distribution* d)
 {
+  auto own = [d](Index id) { return !d || d->Owned(id); };
   this->Grid = &grid;
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
@@ -35,20 +36,22 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     this->InverseRadii[s] = 1.0 / r;
     largest = std::max(largest, r);
   }
+  largest = GlobalMax(d, largest);
   this->QueryRadius = largest;
-  // The tiers (class comment): split at the 50th, 90th and 99th percentiles of the supports.
+  // The tiers (class comment): split at the 50th, 90th and 99th percentiles of the supports (of the whole cloud).
   std::vector<double> supports;
   supports.reserve(static_cast<size_t>(nv));
   for (Index s = 0; s < nv; ++s)
   {
-    if (std::isfinite(this->InverseRadii[s]))
+    if (std::isfinite(this->InverseRadii[s]) && own(order[s]))
     {
       supports.push_back(1.0 / this->InverseRadii[s]);
     }
   }
   this->Tiers.clear();
   this->NearRadius = largest;
-  if (supports.size() < 64)
+  const Index count = GlobalSum(d, static_cast<Index>(supports.size()));
+  if (count < 64)
   {
     return; // one query with the largest support
   }
@@ -56,7 +59,7 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
   std::vector<double> bounds;
   for (const double share : { 0.5, 0.9, 0.99 })
   {
-    const double split = supports[static_cast<size_t>(share * static_cast<double>(supports.size() - 1))];
+    const double split = GlobalSelect(d, supports, static_cast<Index>(share * static_cast<double>(count - 1)));
     // A tier must narrow the query noticeably.
     if (split < 0.9 * largest && (bounds.empty() || split > 1.1 * bounds.back()))
     {
@@ -75,10 +78,10 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
   size_t below = 0;
   for (const double bound : bounds)
   {
-    const size_t upto =
-      static_cast<size_t>(std::upper_bound(supports.begin(), supports.end(), bound) - supports.begin());
-    cost += static_cast<double>(upto - below) / static_cast<double>(supports.size()) * bound * bound;
-    below = upto;
+    const Index upto = GlobalSum(
+      d, static_cast<Index>(std::upper_bound(supports.begin(), supports.end(), bound) - supports.begin()));
+    cost += static_cast<double>(upto - static_cast<Index>(below)) / static_cast<double>(count) * bound * bound;
+    below = static_cast<size_t>(upto);
   }
   if (!(cost < 0.7 * largest * largest))
   {
@@ -100,6 +103,22 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     const size_t tier = std::min(t, bounds.size() - 1);
     coordinates[tier].insert(coordinates[tier].end(), xyz + 3 * s, xyz + 3 * s + 3);
     positions[tier].push_back(s);
+  }
+  // Each tier's grid framed by the whole cloud's tier points (the same cells and order as a serial run's).
+  std::vector<double> ownCoordinates;
+  for (size_t t = 0; d && t < bounds.size(); ++t)
+  {
+    ownCoordinates.clear();
+    for (size_t w = 0; w < positions[t].size(); ++w)
+    {
+      if (own(order[positions[t][w]]))
+      {
+        ownCoordinates.insert(ownCoordinates.end(), &coordinates[t][3 * w], &coordinates[t][3 * w] + 3);
+      }
+    }
+    double frame[6];
+    GlobalBounds(d, ownCoordinates.data(), static_cast<Index>(ownCoordinates.size() / 3), frame);
+    this->Tiers[t].Grid.SetFrame(frame, GlobalSum(d, static_cast<Index>(ownCoordinates.size() / 3)));
   }
   for (size_t t = 0; t < bounds.size(); ++t)
   {

@@ -37,6 +37,7 @@
 #ifndef meshfree_PointSetSurface_h
 #define meshfree_PointSetSurface_h
 
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 #include "Surface/ImplicitField.h"
 
@@ -60,7 +61,10 @@ public:
   /// The cloud: `grid` built over n points, their unit outward normals and support radii h_i (both in the
   /// caller's point order; copied into the grid's sorted order). Points without a valid normal (a zero or
   /// non-finite vector) or radius are ignored.
-  void SetCloud(const NeighborGrid& grid, const double* normals, const double* radii);
+  /// Distributed (d, Common/Distribution.h): the grid holds a process' points and their halo, framed by the whole
+  /// cloud; the tiers are the whole cloud's (their percentiles over every process' points, their grids framed by
+  /// every process' tier points), so that a fit lists its neighbours as the serial run does.
+  void SetCloud(const NeighborGrid& grid, const double* normals, const double* radii, const Distribution* d = nullptr);
 
   /// Fits need at least this many weighted neighbours (default 6).
   void SetMinimumNeighbors(int count) { this->MinimumNeighbors = count < 3 ? 3 : count; }

@@ -2,6 +2,7 @@
 // PCA normals over a density- and noise-adapted neighbourhood (SurfaceNormals.h).
 #include "Surface/SurfaceNormals.h"
 
+#include "Common/Distribution.h"
 #include "Common/LocalFit.h"
 #include "Common/Parallel.h"
 #include "Common/Statistics.h"
@@ -32,6 +33,7 @@ constexpr double FlagFloor = 0.01;
 constexpr double MaxCrossing = 0.2;
 constexpr double NoiseAgreement = 1.5; // the jets' noise at most this many times the PCA spread's (thin parts)
 constexpr double MaxTurn = 0.2; // radians: the most the curvature may turn the normal between a point and its donor
+constexpr Index SamplePoints = 2048; // the scale's sample (CloudSample: by a hash of the positions)
 
 struct LocalPCA
 {
@@ -506,7 +508,7 @@ bool NearestOfList(const double* sorted, const Index* pos, const double* r2, siz
 /// rms and height are per sorted position: the jets' misfit and the point's height over its jet.
 /// meanCurvature: field.MeanCurvature follows the normal (the donor's, or the small jet's).
 void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vector<double>& rms,
-  const std::vector<double>& height, bool meanCurvature)
+  const std::vector<double>& height, bool meanCurvature, const Distribution* d)
 {
   const double* sorted = grid.SortedPoints();
   const std::vector<Index>& order = grid.SortedOrder();
@@ -544,7 +546,7 @@ void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vect
     {
       const Index id = order[s];
       const double radius = field.Radii[id];
-      if (!field.Valid[id] || !flagged(s))
+      if (!field.Valid[id] || !flagged(s) || (d && !d->Owned(id)))
       {
         continue;
       }
@@ -606,29 +608,36 @@ void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vect
       }
     }
   }
+  UpdateHalo(d, field.Normals, 3);
+  if (meanCurvature)
+  {
+    UpdateHalo(d, field.MeanCurvature);
+  }
 }
 
 /// Outliers: points alone in their surroundings, and points farther from their neighbourhood's quadric than
 /// six times the median such distance
 /// (about 4 sigma for Gaussian noise) and than 5 % of the neighbourhood radius (the floor for exact data,
 /// above the quadric's own O(kappa^3 R^4) misfit).
-void FlagOutliers(NormalField& field)
+void FlagOutliers(NormalField& field, const Distribution* d)
 {
   std::vector<double> residuals, distances;
   const size_t n = field.Valid.size();
+  auto own = [d](size_t i) { return !d || d->Owned(static_cast<Index>(i)); };
   for (size_t i = 0; i < n; ++i)
   {
-    if (field.Valid[i])
+    if (field.Valid[i] && own(i))
     {
       residuals.push_back(field.Residual[i]);
       distances.push_back(field.NeighborDistance[i]);
     }
   }
-  const double threshold = std::max(6.0 * Median(residuals), 0.05 * Median(distances));
+  const double threshold =
+    std::max(6.0 * GlobalMedian(d, std::move(residuals)), 0.05 * GlobalMedian(d, std::move(distances)));
   const int k = field.GraphDegree;
   for (size_t i = 0; i < n; ++i)
   {
-    if (!field.Valid[i])
+    if (!field.Valid[i] || !own(i))
     {
       continue;
     }
@@ -652,6 +661,39 @@ void FlagOutliers(NormalField& field)
       ++field.OutlierCount;
     }
   }
+  UpdateHalo(d, field.Outlier);
+}
+
+/// A distributed estimate: the halo points' estimates (every array SharpFeatures, FlagOutliers and the
+/// orientation read of neighbours) replaced by their owners'. rms and height are per sorted position.
+void ShareEstimates(const Distribution* d, const NeighborGrid& grid, NormalField& field, std::vector<double>& rms,
+  std::vector<double>& height, bool meanCurvature)
+{
+  UpdateHalo(d, field.Normals, 3);
+  UpdateHalo(d, field.Radii);
+  UpdateHalo(d, field.NeighborDistance);
+  UpdateHalo(d, field.Residual);
+  UpdateHalo(d, field.SurfaceVariation);
+  if (meanCurvature) // the same on every process (an empty piece's array is empty too)
+  {
+    UpdateHalo(d, field.MeanCurvature);
+  }
+  UpdateHalo(d, field.Valid);
+  UpdateHaloRows(d, field.Graph, field.GraphDegree);
+  const std::vector<Index>& order = grid.SortedOrder();
+  const Index nv = static_cast<Index>(order.size());
+  std::vector<double> perPoint(2 * field.Valid.size(), 0.0);
+  for (Index s = 0; s < nv; ++s)
+  {
+    perPoint[2 * order[s]] = rms[s];
+    perPoint[2 * order[s] + 1] = height[s];
+  }
+  UpdateHalo(d, perPoint, 2);
+  for (Index s = 0; s < nv; ++s)
+  {
+    rms[s] = perPoint[2 * order[s]];
+    height[s] = perPoint[2 * order[s] + 1];
+  }
 }
 
 /// The radius that keeps the noise's tilt below tau: R^2 = 2 sigma h / (sqrt(pi) tau).
@@ -661,18 +703,21 @@ double NoiseRadius(double noise, double spacing, double tau)
 }
 /// The normals' radius (CloudScale::NormalRadius): rounds of (radius -> jets over the sample -> the noise as
 /// their median misfit and the curvature as their median -> radius), see SurfaceNormals.h.
-void EstimateNormalRadius(const NeighborGrid& grid, const NormalOptions& options, CloudScale& scale)
+void EstimateNormalRadius(
+  const NeighborGrid& grid, const NormalOptions& options, const CloudSample& sample, CloudScale& scale)
 {
-  const Index nv = grid.NumberOfValidPoints();
+  const Distribution* d = options.Processes;
   const int k = std::max(3, options.NeighborCount);
   const double rk = scale.Spacing / std::sqrt(Pi / k);
-  if (nv < 3 || !(rk > 0.0))
+  if (sample.Size() < 3 || !(rk > 0.0))
   {
     return;
   }
-  const Index samples = std::min<Index>(nv, 2048);
+  const Index samples = sample.Size();
+  const Index mineCount = static_cast<Index>(sample.Local().size());
   const double* sorted = grid.SortedPoints();
-  std::vector<double> rms(static_cast<size_t>(samples), 0.0), curvature(static_cast<size_t>(samples), 0.0);
+  std::vector<double> rms, curvature;
+  std::vector<double> localRms(static_cast<size_t>(mineCount), 0.0), localCurvature(static_cast<size_t>(mineCount));
   struct Buffers
   {
     std::vector<Index> Positions;
@@ -682,17 +727,23 @@ void EstimateNormalRadius(const NeighborGrid& grid, const NormalOptions& options
   const double cap = scale.Spacing * std::sqrt(MaxNeighbors / Pi);
   double radius = rk;
   auto fitSample = [&]() {
-    ParallelFor(samples, 16, [&](Index begin, Index end) {
+    ParallelFor(mineCount, 16, [&](Index begin, Index end) {
       Buffers& mine = buffers.Local();
       for (Index j = begin; j < end; ++j)
       {
-        const double* x = sorted + 3 * (j * nv / samples);
+        const double* x = sorted + 3 * sample.Local()[j];
         grid.FindWithinRadiusPositions(x, radius, mine.Positions, mine.Dist2);
         const JetFit fit = FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, radius);
-        rms[j] = fit.Valid ? fit.Rms : 0.0;
-        curvature[j] = fit.Valid ? fit.Curvature : 0.0;
+        localRms[j] = fit.Valid ? fit.Rms : 0.0;
+        localCurvature[j] = fit.Valid ? fit.Curvature : 0.0;
       }
     });
+    for (Index j = 0; j < mineCount; ++j)
+    {
+      scale.SampleShortfall = std::max(scale.SampleShortfall, Shortfall(d, sorted + 3 * sample.Local()[j], radius));
+    }
+    rms = sample.Gather(d, localRms);
+    curvature = sample.Gather(d, localCurvature);
     // The misfit also grows where a neighbourhood takes in two sheets (a part thinner than it): the noise is
     // at most NoiseAgreement x the PCA spread at the fits' own radius (CloudScale::Noise), which stays small
     // there; the jets that misfit beyond it then shrink the radius as a crease's do.
@@ -743,14 +794,19 @@ void EstimateNormalRadius(const NeighborGrid& grid, const NormalOptions& options
 CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& options)
 {
   CloudScale scale;
+  const Distribution* d = options.Processes;
   const Index nv = grid.NumberOfValidPoints();
-  if (nv < 3)
+  const std::vector<Index>& order = grid.SortedOrder();
+  const double* sorted = grid.SortedPoints();
+  // The sample: the same points whatever the input's order and split among processes (CloudSample).
+  CloudSample sample;
+  sample.Choose(d, sorted, nv, SamplePoints, [&](Index s) { return !d || d->Owned(order[s]); });
+  if (sample.Size() < 3)
   {
     return scale;
   }
   const int k = std::max(3, options.NeighborCount);
-  const Index samples = std::min<Index>(nv, 2048);
-  const double* sorted = grid.SortedPoints();
+  const Index samples = static_cast<Index>(sample.Local().size());
   std::vector<double> kth(static_cast<size_t>(samples), 0.0);
   std::vector<double> spread(static_cast<size_t>(samples), 0.0);
   // Per-thread query buffers of both loops below.
@@ -767,8 +823,7 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
     std::vector<Index>& pos = mine.Positions;
     for (Index j = begin; j < end; ++j)
     {
-      const Index s = j * nv / samples;
-      const double* x = sorted + 3 * s;
+      const double* x = sorted + 3 * sample.Local()[j];
       const int found = NearestDistinct(grid, x, k, ids, d2, kth[j]);
       if (found < 4 || !(kth[j] > 0.0))
       {
@@ -780,9 +835,13 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
       spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
     }
   });
-  const double rk = Median(kth);
+  for (Index j = 0; j < samples; ++j)
+  {
+    scale.SampleShortfall = std::max(scale.SampleShortfall, Shortfall(d, sorted + 3 * sample.Local()[j], kth[j]));
+  }
+  const double rk = Median(sample.Gather(d, kth));
   scale.Spacing = rk * std::sqrt(Pi / k);
-  scale.Noise = Median(spread);
+  scale.Noise = Median(sample.Gather(d, spread));
   if (!options.AdaptToNoise || !(scale.Spacing > 0.0))
   {
     return scale;
@@ -796,13 +855,17 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
       std::vector<double>& d2 = buffers.Local().Dist2;
       for (Index j = begin; j < end; ++j)
       {
-        const double* x = sorted + 3 * (j * nv / samples);
+        const double* x = sorted + 3 * sample.Local()[j];
         grid.FindWithinRadiusPositions(x, radius, pos, d2);
         const LocalPCA pca = PrincipalAxes(sorted, pos.data(), pos.size(), x, radius);
         spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
       }
     });
-    scale.Noise = Median(spread);
+    for (Index j = 0; j < samples; ++j)
+    {
+      scale.SampleShortfall = std::max(scale.SampleShortfall, Shortfall(d, sorted + 3 * sample.Local()[j], radius));
+    }
+    scale.Noise = Median(sample.Gather(d, spread));
     const double next = std::max(rk, NoiseRadius(scale.Noise, scale.Spacing, options.TiltTolerance));
     const bool settled = std::fabs(next - radius) < 0.05 * radius;
     radius = next;
@@ -812,13 +875,14 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
     }
   }
   scale.Radius = radius > rk ? radius : 0.0;
-  EstimateNormalRadius(grid, options, scale);
+  EstimateNormalRadius(grid, options, sample, scale);
   return scale;
 }
 
 bool EstimateNormals(
   const NeighborGrid& grid, const NormalOptions& options, NormalField& field, const ProgressCallback& progress)
 {
+  const Distribution* d = options.Processes;
   const Index n = grid.NumberOfPoints();
   const int degree = std::max(1, options.GraphDegree);
   field.Normals.assign(static_cast<size_t>(3 * n), 0.0);
@@ -834,7 +898,22 @@ bool EstimateNormals(
   field.GraphDegree = degree;
   field.Scale = CloudScale();
   field.InvalidCount = n;
-  if (grid.NumberOfValidPoints() < 3)
+  field.Shortfall = -HUGE_VAL;
+  Index ownValid = grid.NumberOfValidPoints();
+  if (d)
+  {
+    ownValid = 0;
+    for (Index i : grid.SortedOrder())
+    {
+      ownValid += d->Owned(i) ? 1 : 0;
+    }
+    field.InvalidCount = 0;
+    for (Index i = 0; i < n; ++i)
+    {
+      field.InvalidCount += d->Owned(i) ? 1 : 0;
+    }
+  }
+  if (GlobalSum(d, ownValid) < 3)
   {
     return false;
   }
@@ -870,6 +949,7 @@ bool EstimateNormals(
   {
     std::vector<Index> Ids, Positions, Small, Local;
     std::vector<double> Dist2, Radius2, Keys, SmallD2;
+    double Shortfall = -HUGE_VAL;
   };
   PerThread<Buffers> buffers;
   for (Index begin = 0; begin < nv && !aborted; begin += chunk)
@@ -884,9 +964,14 @@ bool EstimateNormals(
         std::vector<double>& r2 = mine.Radius2;
         std::vector<double>& keys = mine.Keys;
         Index failed = 0;
+        double& shortfall = mine.Shortfall;
         for (Index s = begin + b0; s < begin + b1; ++s)
         {
           const Index id = order[s];
+          if (d && !d->Owned(id))
+          {
+            continue; // a halo point: its owner estimates it
+          }
           const double* x = sorted + 3 * s;
           std::int32_t* row = &field.Graph[static_cast<size_t>(id) * degree];
           // One radius query, wide enough for every radius the point may need, usually holds its k nearest too:
@@ -936,6 +1021,11 @@ bool EstimateNormals(
           }
           const double rk = field.NeighborDistance[id];
           const double radius = fixed ? options.SupportRadius : std::max(rk, normalRadius);
+          if (d)
+          {
+            const double farthest = std::max(std::max(queried, radius), std::max(rk, std::sqrt(nearLimit2)));
+            shortfall = std::max(shortfall, Shortfall(d, x, farthest));
+          }
           if (queried < radius)
           {
             grid.FindWithinRadiusPositions(x, radius, pos, r2);
@@ -1008,21 +1098,37 @@ bool EstimateNormals(
     invalid += bad;
     aborted = progress && !progress(0.9 * static_cast<double>(end) / static_cast<double>(nv));
   }
+  if (d)
+  {
+    // Over own points only; the halo's estimates come from their owners (aborting is not collective: the
+    // processes go on together and the caller discards the result).
+    invalid = 0;
+    for (Index i = 0; i < n; ++i)
+    {
+      invalid += d->Owned(i) && !field.Valid[i] ? 1 : 0;
+    }
+    ShareEstimates(d, grid, field, rms, height, options.MeanCurvature);
+  }
   field.InvalidCount = invalid;
-  if (!aborted && !fixed && options.AdaptToNoise && options.WideNormals)
+  for (const Buffers& b : buffers)
   {
-    SharpFeatures(grid, field, rms, height, options.MeanCurvature);
-    aborted = progress && !progress(1.0);
+    field.Shortfall = std::max(field.Shortfall, b.Shortfall);
   }
-  if (!aborted)
+  field.Shortfall = std::max(field.Shortfall, field.Scale.SampleShortfall);
+  if (!fixed && options.AdaptToNoise && options.WideNormals && (d || !aborted))
   {
-    FlagOutliers(field);
+    SharpFeatures(grid, field, rms, height, options.MeanCurvature, d);
+    aborted = aborted || (progress && !progress(1.0));
   }
-  return !aborted && invalid < n;
+  if (d || !aborted)
+  {
+    FlagOutliers(field, d);
+  }
+  return !aborted && (d || invalid < n);
 }
 
-std::vector<double> FitSupports(
-  const NormalField& field, double supportScale, double noiseScale, bool fixedRadius, double& median)
+std::vector<double> FitSupports(const NormalField& field, double supportScale, double noiseScale, bool fixedRadius,
+  double& median, const Distribution* d)
 {
   const size_t n = field.Radii.size();
   std::vector<double> support(n, 0.0);
@@ -1037,14 +1143,14 @@ std::vector<double> FitSupports(
   }
   std::vector<double> positive;
   positive.reserve(n);
-  for (double r : support)
+  for (size_t i = 0; i < n; ++i)
   {
-    if (r > 0.0)
+    if (support[i] > 0.0 && (!d || d->Owned(static_cast<Index>(i))))
     {
-      positive.push_back(r);
+      positive.push_back(support[i]);
     }
   }
-  median = Median(positive);
+  median = GlobalMedian(d, std::move(positive));
   for (double& r : support)
   {
     r = std::min(r, 3.0 * median);

@@ -12,7 +12,9 @@
  *
  * Neighbourhood (CloudScale::NormalRadius, one radius R* per cloud, at least r_k at each point). The noise
  * tilts a jet's slopes by about 2 sigma h / (sqrt(pi) R^2) (h the spacing, sigma the noise along the normal);
- * the bias grows with R (third-order terms, and across creases). On a sample of 2048 points: sigma is the
+ * the bias grows with R (third-order terms, and across creases). On a sample of 2048 points (the points whose
+ * coordinates hash lowest, Common/Distribution.h's CloudSample: the same sample whatever the order and split of
+ * the cloud): sigma is the
  * median root mean square misfit of the jets (exact data: ~0, so R* = r_k), R* the radius that keeps the
  * noise's tilt below 0.0025 rad (rounds of radius -> misfit -> radius, as a neighbourhood smaller than the noise
  * hides it; Mitra, Nguyen & Guibas 2004 choose the radius the same way), capped at 0.9 / the median curvature
@@ -38,6 +40,12 @@
  * Order independence: every neighbour choice breaks distance ties by position (NeighborGrid::NeighborBefore)
  * and every sum runs in the grid's cell order: a permuted input gives the same bits.
  *
+ * Distributed (NormalOptions::Processes): each process estimates its own points over its piece and halo (a grid
+ * framed by the whole cloud, so that its queries list points as the serial grid does), the sample's figures are
+ * gathered, the medians are exact selections over all processes, and the halo points' estimates (normals, radii,
+ * misfits, the graph) come from their owners before the crease pass, the outliers and the orientation read them:
+ * the same bits as the serial run, as long as the halo holds every point a query reaches (NormalField::Shortfall).
+ *
  * Invalid normals (zero vector, Valid 0): points with NaN/Inf coordinates, and points whose neighbourhood
  * has fewer than 3 points or is collinear (l1 ~ 0). Exact duplicates of a point do not count as its
  * neighbours (they would shrink r_k without adding any sampling).
@@ -51,9 +59,11 @@
 #ifndef meshfree_SurfaceNormals_h
 #define meshfree_SurfaceNormals_h
 
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 #include "Common/Progress.h"
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -71,6 +81,10 @@ struct NormalOptions
   int GraphDegree = 8;          // nearest neighbours kept for the orientation graph
   bool MeanCurvature = false;   // NormalField::MeanCurvature from each normal's jet (a second, sphere-exact jet
                                 // over the same neighbours; the normals are the same bits either way)
+  const Distribution* Processes = nullptr; // a cloud split among processes (Common/Distribution.h): the grid
+                                // holds this process' points and their halo, framed by the whole cloud
+                                // (NeighborGrid::SetFrame); own points are estimated, the halo's come from
+                                // their owners; statistics are the whole cloud's. Null: serial.
 };
 
 /// The cloud's sampling scale, from a sample of its points (medians).
@@ -82,6 +96,7 @@ struct CloudScale
   double FitNoise = 0.0;     // the median root mean square misfit of the normals' jets (sigma along the normal)
   double Curvature = 0.0;    // the median larger principal curvature of the normals' jets
   double NormalRadius = 0.0; // the normals' jet radius (0 when the density decides), see the file comment
+  double SampleShortfall = -HUGE_VAL; // distributed: Shortfall() of the sample points' queries (<= 0: complete)
 };
 
 struct NormalField
@@ -99,8 +114,9 @@ struct NormalField
   std::vector<std::int32_t> Graph;      // GraphDegree nearest other points per point (-1 pads)
   int GraphDegree = 0;
   CloudScale Scale;
-  Index InvalidCount = 0;
+  Index InvalidCount = 0;        // over this process' own points (all when serial)
   Index OutlierCount = 0;
+  double Shortfall = -HUGE_VAL;  // distributed: the largest Shortfall() of an own point's query (<= 0: complete)
 };
 
 /// Normals of the points the grid was built over (grid.NumberOfPoints(), in their original order). Returns
@@ -115,8 +131,9 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
 /// random sampling) but at least noiseScale x the noise radius (averages the noise), or supportScale x the
 /// fixed radius when one was given; 0 for invalid points. Capped at three times their median, so that a few
 /// isolated points (outliers, the noise's tails) do not widen every neighbour query. `median` receives it.
-std::vector<double> FitSupports(
-  const NormalField& field, double supportScale, double noiseScale, bool fixedRadius, double& median);
+/// Distributed (d): the median is the whole cloud's.
+std::vector<double> FitSupports(const NormalField& field, double supportScale, double noiseScale, bool fixedRadius,
+  double& median, const Distribution* d = nullptr);
 
 } // namespace meshfree
 

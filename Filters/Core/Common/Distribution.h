@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @brief What a computation over a cloud split among several processes needs from them, so that the core stays
+ *        free of MPI (the VTK layer implements it with vtkMultiProcessController: vtkMeshFreeHalo).
+ *
+ * A process' local cloud is its own points and a halo: copies of other processes' points near its own, enough
+ * for every neighbourhood its own points' computations read. Each local point is owned by exactly one process
+ * (Owned()); the values the computation writes for halo points are replaced by their owners' (UpdateHalo), so a
+ * value that depends on the neighbours' values (a second level) is the same everywhere. Global statistics are
+ * reductions over the owned points; the medians are exact (GlobalMedian selects the same element a serial
+ * median selects), so every process takes the same decisions as a serial run.
+ *
+ * Every method is collective: every process calls it, in the same order, with an empty piece too. A null
+ * Distribution means a serial computation: every point is owned and the helpers below are the local operations.
+ */
+#ifndef meshfree_Distribution_h
+#define meshfree_Distribution_h
+
+#include <cstdint>
+#include <vector>
+
+namespace meshfree
+{
+using Index = std::int64_t;
+
+class Distribution
+{
+public:
+  virtual ~Distribution() = default;
+  /// Whether local point i is this process' own (every point of the whole cloud is owned by one process).
+  virtual bool Owned(Index i) const = 0;
+  /// A key of local point i unique over the whole cloud and the same on every process (the global id).
+  virtual std::int64_t Key(Index i) const = 0;
+  /// Element-wise sums and maxima over the processes, in place (count the same on every process).
+  virtual void Sum(double* values, Index count) const = 0;
+  virtual void Sum(std::int64_t* values, Index count) const = 0;
+  virtual void Max(double* values, Index count) const = 0;
+  /// The concatenation of every process' `mine`, in process order (the same on every process).
+  virtual void Gather(const std::vector<double>& mine, std::vector<double>& all) const = 0;
+  /// The halo points' `components` values (interleaved, one tuple per local point) replaced by their owners'.
+  virtual void UpdateHalo(double* values, int components) const = 0;
+  /// How far around x (an own point) the local cloud is complete: every point of the whole cloud within this
+  /// distance of x is in it (the halo's radius plus x's distance to the border of the region it was grown from).
+  virtual double Complete(const double x[3]) const = 0;
+};
+
+/// How far a query of radius `reach` around x exceeds what the local cloud holds (<= 0: it found every point
+/// the whole cloud has there); -infinity when serial. A computation reports the largest: a halo that is wider
+/// by that much gives the same result as the serial run.
+double Shortfall(const Distribution* d, const double x[3], double reach);
+
+/// Sums and maxima over the processes (the value itself when serial).
+double GlobalSum(const Distribution* d, double value);
+Index GlobalSum(const Distribution* d, Index value);
+double GlobalMax(const Distribution* d, double value);
+/// The median of the values of every process (Statistics.h's Median of their union: the upper median), exact:
+/// a radix selection over the values' bits, four rounds of 65,536 counts.
+double GlobalMedian(const Distribution* d, std::vector<double> values);
+/// The element of 0-based rank `rank` in the ascending order of every process' values (the same selection); 0 when
+/// there are none.
+double GlobalSelect(const Distribution* d, std::vector<double> values, Index rank);
+/// The bounds (xmin, xmax, ...) of every process' finite points among n interleaved xyz (min > max when none).
+void GlobalBounds(const Distribution* d, const double* xyz, Index n, double bounds[6]);
+
+/// UpdateHalo for per-point vectors of other types (values converted exactly through double).
+void UpdateHalo(const Distribution* d, std::vector<double>& values, int components = 1);
+void UpdateHalo(const Distribution* d, std::vector<unsigned char>& values);
+/// Rows of `width` local point indices per point (-1 pads, as neighbour graphs store them): the halo points' rows
+/// replaced by their owners', translated through Key() (an entry whose point is not in the local cloud: -1).
+void UpdateHaloRows(const Distribution* d, std::vector<std::int32_t>& rows, int width);
+
+/// A sample of a cloud's points that does not depend on their order nor on how they are split among the
+/// processes: the `count` points (of the whole cloud) with the smallest hash of their coordinates' bits. The
+/// local cloud's candidates are given by `positions` (e.g. a grid's sorted points) with `eligible(i)`.
+class CloudSample
+{
+public:
+  /// Chooses the sample among the points xyz[3 i] with eligible(i) (this process' own points). Collective.
+  template <class Eligible>
+  void Choose(const Distribution* d, const double* xyz, Index n, Index count, const Eligible& eligible)
+  {
+    std::vector<Candidate> candidates;
+    for (Index i = 0; i < n; ++i)
+    {
+      if (eligible(i))
+      {
+        candidates.push_back({ Hash(xyz + 3 * i), i });
+      }
+    }
+    this->Select(d, xyz, candidates, count);
+  }
+  /// This process' sample points (indices given to Choose), in the sample's order.
+  const std::vector<Index>& Local() const { return this->Mine; }
+  /// The number of points in the whole sample.
+  Index Size() const { return this->Total; }
+  /// One value per local sample point (in Local()'s order) -> the whole sample's values in the sample's order.
+  std::vector<double> Gather(const Distribution* d, const std::vector<double>& mine) const;
+
+private:
+  struct Candidate
+  {
+    std::uint64_t Hash;
+    Index Point;
+  };
+  static std::uint64_t Hash(const double x[3]);
+  void Select(const Distribution* d, const double* xyz, std::vector<Candidate>& candidates, Index count);
+  std::vector<Index> Mine;
+  std::vector<Index> Rank; // per local sample point: its place in the whole sample
+  Index Total = 0;
+};
+
+} // namespace meshfree
+
+#endif

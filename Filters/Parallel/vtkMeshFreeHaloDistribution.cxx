@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkMeshFreeHaloDistribution.h"
+
+#include "vtkCommunicator.h"
+#include "vtkDoubleArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkMeshFreeHalo.h"
+#include "vtkMeshFreePieces.h"
+#include "vtkMultiProcessController.h"
+#include "vtkNew.h"
+#include "vtkPolyData.h"
+
+#include <algorithm>
+#include <cmath>
+
+vtkMeshFreeHaloDistribution::vtkMeshFreeHaloDistribution(
+  vtkMultiProcessController* controller, vtkMeshFreeHalo* halo, const double region[6], double radius)
+  : Controller(controller)
+  , Halo(halo)
+  , NumberOfOwned(halo->GetNumberOfOwnedPoints())
+  , Radius(radius)
+{
+  std::copy(region, region + 6, this->Region);
+  vtkIdTypeArray* ids = halo->GetGlobalIds();
+  const vtkIdType n = halo->GetOutput()->GetNumberOfPoints();
+  this->Ids.resize(static_cast<size_t>(n));
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    this->Ids[i] = ids ? static_cast<std::int64_t>(ids->GetValue(i)) : static_cast<std::int64_t>(i);
+  }
+}
+
+double vtkMeshFreeHaloDistribution::Complete(const double x[3]) const
+{
+  double depth = HUGE_VAL;
+  for (int a = 0; a < 3; ++a)
+  {
+    depth = std::min(depth, std::min(x[a] - this->Region[2 * a], this->Region[2 * a + 1] - x[a]));
+  }
+  return this->Radius + std::max(depth, 0.0);
+}
+
+void vtkMeshFreeHaloDistribution::Sum(double* values, meshfree::Index count) const
+{
+  std::vector<double> mine(values, values + count);
+  this->Controller->AllReduce(mine.data(), values, count, vtkCommunicator::SUM_OP);
+}
+
+void vtkMeshFreeHaloDistribution::Sum(std::int64_t* values, meshfree::Index count) const
+{
+  std::vector<vtkTypeInt64> mine(values, values + count), all(static_cast<size_t>(count));
+  this->Controller->AllReduce(mine.data(), all.data(), count, vtkCommunicator::SUM_OP);
+  std::copy(all.begin(), all.end(), values);
+}
+
+void vtkMeshFreeHaloDistribution::Max(double* values, meshfree::Index count) const
+{
+  std::vector<double> mine(values, values + count);
+  this->Controller->AllReduce(mine.data(), values, count, vtkCommunicator::MAX_OP);
+}
+
+void vtkMeshFreeHaloDistribution::Gather(const std::vector<double>& mine, std::vector<double>& all) const
+{
+  all = vtkMeshFreePieces::AllGather(this->Controller, mine);
+}
+
+void vtkMeshFreeHaloDistribution::UpdateHalo(double* values, int components) const
+{
+  vtkNew<vtkDoubleArray> array;
+  array->SetNumberOfComponents(components);
+  array->SetArray(values, static_cast<vtkIdType>(this->Ids.size()) * components, 1); // 1: not freed by the array
+  this->Halo->UpdateHalo(array);
+}

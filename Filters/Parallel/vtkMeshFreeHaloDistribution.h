@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file    vtkMeshFreeHaloDistribution.h
+ * @brief   The core's Distribution (Filters/Core/Common/Distribution.h) over a vtkMultiProcessController and a
+ *          vtkMeshFreeHalo exchange (private to MeshFree::Filters, not wrapped).
+ *
+ * The local cloud is the halo's output: the rank's own points first, then the halo. Owned(i): i is one of the
+ * first GetNumberOfOwnedPoints(); Key(i): the global point id; UpdateHalo: vtkMeshFreeHalo::UpdateHalo; sums,
+ * maxima and gathers: the controller's AllReduce and AllGatherV; Complete(x): the halo's radius plus x's depth
+ * inside the region the halo was grown from. Every method but Owned, Key and Complete is collective.
+ */
+#ifndef vtkMeshFreeHaloDistribution_h
+#define vtkMeshFreeHaloDistribution_h
+
+#include "Common/Distribution.h"
+
+#include "vtkType.h"
+
+#include <cstddef>
+#include <vector>
+
+class vtkMeshFreeHalo;
+class vtkMultiProcessController;
+
+class vtkMeshFreeHaloDistribution : public meshfree::Distribution
+{
+public:
+  /// The halo must have exchanged (Exchange, with `region` and `radius`) before; it must outlive this object.
+  vtkMeshFreeHaloDistribution(
+    vtkMultiProcessController* controller, vtkMeshFreeHalo* halo, const double region[6], double radius);
+
+  bool Owned(meshfree::Index i) const override { return i < this->NumberOfOwned; }
+  std::int64_t Key(meshfree::Index i) const override { return this->Ids[static_cast<size_t>(i)]; }
+  void Sum(double* values, meshfree::Index count) const override;
+  void Sum(std::int64_t* values, meshfree::Index count) const override;
+  void Max(double* values, meshfree::Index count) const override;
+  void Gather(const std::vector<double>& mine, std::vector<double>& all) const override;
+  void UpdateHalo(double* values, int components) const override;
+  /// The radius plus x's distance to the border of the region (0 outside it).
+  double Complete(const double x[3]) const override;
+
+private:
+  vtkMultiProcessController* Controller;
+  vtkMeshFreeHalo* Halo;
+  meshfree::Index NumberOfOwned = 0;
+  double Region[6];
+  double Radius;
+  std::vector<std::int64_t> Ids;
+};
+
+#endif
