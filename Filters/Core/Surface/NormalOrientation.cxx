@@ -153,44 +153,27 @@ private:
 /// spacings: a few hundred points of a surface per block).
 constexpr double BlockNeighborhoods = 4.0;
 
-/// Node entries (node, sums) -> one per node, sums added (in gathered order: process by process), every
-/// process' included; nodes sorted.
-void ReduceNodes(const Distribution* d, std::vector<std::pair<Node, std::array<double, 8>>>& entries,
-  std::vector<Node>& nodes, std::vector<std::array<double, 8>>& sums)
+/// The nodes of the blocks oriented here (sorted, each once) and their sums over own points -> every process'
+/// nodes, each once, sums added (in gathered order: process by process); nodes sorted.
+void ReduceNodes(const Distribution* d, const std::vector<Node>& localNodes,
+  const std::vector<std::array<double, 8>>& localSums, std::vector<Node>& nodes, std::vector<std::array<double, 8>>& sums)
 {
-  auto reduce = [&]() {
-    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    nodes.clear();
-    sums.clear();
-    for (const auto& e : entries)
-    {
-      if (nodes.empty() || !(nodes.back() == e.first))
-      {
-        nodes.push_back(e.first);
-        sums.push_back(e.second);
-        continue;
-      }
-      for (int c = 0; c < 8; ++c)
-      {
-        sums.back()[c] += e.second[c];
-      }
-    }
-  };
-  reduce();
   if (!d)
   {
+    nodes = localNodes;
+    sums = localSums;
     return;
   }
   std::vector<double> mine, all;
-  for (size_t m = 0; m < nodes.size(); ++m)
+  for (size_t m = 0; m < localNodes.size(); ++m)
   {
-    mine.insert(mine.end(), { static_cast<double>(nodes[m].Block >> 32),
-                              static_cast<double>(nodes[m].Block & 0xffffffffull),
-                              static_cast<double>(nodes[m].Component) });
-    mine.insert(mine.end(), sums[m].begin(), sums[m].end());
+    mine.insert(mine.end(), { static_cast<double>(localNodes[m].Block >> 32),
+                              static_cast<double>(localNodes[m].Block & 0xffffffffull),
+                              static_cast<double>(localNodes[m].Component) });
+    mine.insert(mine.end(), localSums[m].begin(), localSums[m].end());
   }
   d->Gather(mine, all);
-  entries.clear();
+  std::vector<std::pair<Node, std::array<double, 8>>> entries;
   for (size_t e = 0; e + 11 <= all.size(); e += 11)
   {
     const double* v = &all[e];
@@ -200,7 +183,22 @@ void ReduceNodes(const Distribution* d, std::vector<std::pair<Node, std::array<d
                           static_cast<std::int64_t>(v[2]) },
       values });
   }
-  reduce();
+  std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  nodes.clear();
+  sums.clear();
+  for (const auto& e : entries)
+  {
+    if (nodes.empty() || !(nodes.back() == e.first))
+    {
+      nodes.push_back(e.first);
+      sums.push_back(e.second);
+      continue;
+    }
+    for (int c = 0; c < 8; ++c)
+    {
+      sums.back()[c] += e.second[c];
+    }
+  }
 }
 
 /// Votes (a, b, q) -> one per pair, q added, every process' included; pairs sorted.
@@ -403,6 +401,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   std::vector<std::int32_t> parent(static_cast<size_t>(nv), -1);
   std::vector<std::int64_t> component(static_cast<size_t>(nv), -1);
   std::vector<float> key(static_cast<size_t>(nv), std::numeric_limits<float>::infinity());
+  std::vector<std::int64_t> blockComponents(wanted.size(), 0);
   PerThread<BucketQueue> queues;
   ParallelFor(static_cast<Index>(wanted.size()), 1, [&](Index b0, Index b1) {
     BucketQueue& heap = queues.Local();
@@ -461,22 +460,31 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
         }
         ++count;
       }
+      blockComponents[b] = count;
     }
   });
+  // The nodes of the blocks oriented here, numbered block by block (sorted: blocks, then components).
+  std::vector<size_t> nodeBegin(wanted.size() + 1, 0);
+  for (size_t b = 0; b < wanted.size(); ++b)
+  {
+    nodeBegin[b + 1] = nodeBegin[b] + static_cast<size_t>(blockComponents[b]);
+  }
 
   // Per point: its node (block, component) and whether the propagation turned it; the halo's from its owners.
   std::vector<double> state(static_cast<size_t>(4 * n), 0.0);
-  for (Index s = 0; s < nv; ++s)
-  {
-    if (component[s] >= 0)
+  ParallelFor(nv, 4096, [&](Index b0, Index b1) {
+    for (Index s = b0; s < b1; ++s)
     {
-      double* st = &state[4 * order[s]];
-      st[0] = Dot(&normals[3 * s], &field.Normals[3 * order[s]]) < 0.0 ? -1.0 : 1.0;
-      st[1] = static_cast<double>(blockOf[s] >> 32);
-      st[2] = static_cast<double>(blockOf[s] & 0xffffffffull);
-      st[3] = static_cast<double>(component[s] + 1); // 0: none
+      if (component[s] >= 0)
+      {
+        double* st = &state[4 * order[s]];
+        st[0] = Dot(&normals[3 * s], &field.Normals[3 * order[s]]) < 0.0 ? -1.0 : 1.0;
+        st[1] = static_cast<double>(blockOf[s] >> 32);
+        st[2] = static_cast<double>(blockOf[s] & 0xffffffffull);
+        st[3] = static_cast<double>(component[s] + 1); // 0: none
+      }
     }
-  }
+  });
   UpdateHalo(d, state, 4);
   auto nodeOf = [&state](Index id) {
     const double* st = &state[4 * id];
@@ -485,43 +493,65 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   };
 
   // Each node's sums over own points (count, position relative to the blocks' origin, turned normal, n . x) and
-  // the votes of the graph's edges between nodes (|n_i . n_j| rounded to integers: exact sums in any order).
-  std::vector<std::pair<Node, std::array<double, 8>>> nodeSums;
+  // the votes of the graph's edges between nodes (n_i . n_j rounded to integers: exact sums in any order), block
+  // by block in parallel.
+  std::vector<Node> localNodes(nodeBegin.back());
+  std::vector<std::array<double, 8>> localSums(nodeBegin.back(), std::array<double, 8>{});
+  PerThread<std::vector<std::tuple<Node, Node, std::int64_t>>> threadVotes;
+  ParallelFor(static_cast<Index>(wanted.size()), 4, [&](Index b0, Index b1) {
+    std::vector<std::tuple<Node, Node, std::int64_t>>& votes = threadVotes.Local();
+    for (Index b = b0; b < b1; ++b)
+    {
+      for (std::int64_t c = 0; c < blockComponents[b]; ++c)
+      {
+        localNodes[nodeBegin[b] + c] = Node{ wanted[b], c };
+      }
+      for (size_t m = blockBegin[b]; m < blockBegin[b + 1]; ++m)
+      {
+        const std::int32_t s = members[m].second;
+        const Index id = order[s];
+        if (!own(id))
+        {
+          continue;
+        }
+        const Node a{ wanted[b], component[s] };
+        const double x[3] = { xyz[3 * s] - blocks.Origin[0], xyz[3 * s + 1] - blocks.Origin[1],
+          xyz[3 * s + 2] - blocks.Origin[2] };
+        const double* ni = &normals[3 * s];
+        std::array<double, 8>& sum = localSums[nodeBegin[b] + component[s]];
+        const double add[8] = { 1.0, x[0], x[1], x[2], ni[0], ni[1], ni[2], Dot(ni, x) };
+        for (int c = 0; c < 8; ++c)
+        {
+          sum[c] += add[c];
+        }
+        for (int j = 0; j < k; ++j)
+        {
+          const std::int32_t v = field.Graph[static_cast<size_t>(id) * k + j];
+          if (v < 0 || state[4 * static_cast<size_t>(v) + 3] < 1.0)
+          {
+            continue;
+          }
+          const Node other = nodeOf(v);
+          if (other == a)
+          {
+            continue;
+          }
+          const double c = state[4 * static_cast<size_t>(v)] * Dot(ni, &field.Normals[3 * static_cast<size_t>(v)]);
+          votes.emplace_back(std::min(a, other), std::max(a, other), std::llround(c * VoteScale));
+        }
+      }
+    }
+  });
   std::vector<std::tuple<Node, Node, std::int64_t>> votes;
-  for (Index s = 0; s < nv; ++s)
+  for (const auto& mine : threadVotes)
   {
-    const Index id = order[s];
-    if (component[s] < 0 || !own(id))
-    {
-      continue;
-    }
-    const Node a = nodeOf(id);
-    const double x[3] = { xyz[3 * s] - blocks.Origin[0], xyz[3 * s + 1] - blocks.Origin[1],
-      xyz[3 * s + 2] - blocks.Origin[2] };
-    const double* ni = &normals[3 * s];
-    nodeSums.push_back({ a, { 1.0, x[0], x[1], x[2], ni[0], ni[1], ni[2], Dot(ni, x) } });
-    for (int j = 0; j < k; ++j)
-    {
-      const std::int32_t v = field.Graph[static_cast<size_t>(id) * k + j];
-      if (v < 0 || state[4 * static_cast<size_t>(v) + 3] < 1.0)
-      {
-        continue;
-      }
-      const Node b = nodeOf(v);
-      if (b == a)
-      {
-        continue;
-      }
-      const double c = state[4 * static_cast<size_t>(v)] * Dot(ni, &field.Normals[3 * static_cast<size_t>(v)]);
-      const std::int64_t q = std::llround(c * VoteScale);
-      votes.emplace_back(std::min(a, b), std::max(a, b), q);
-    }
+    votes.insert(votes.end(), mine.begin(), mine.end());
   }
   // Reduced here, then over the processes (every process gets the same node list and votes).
   std::vector<Node> nodes;
   std::vector<std::array<double, 8>> sums;
   std::vector<std::tuple<Node, Node, std::int64_t>> links;
-  ReduceNodes(d, nodeSums, nodes, sums);
+  ReduceNodes(d, localNodes, localSums, nodes, sums);
   ReduceVotes(d, votes, links);
 
   // The nodes' relative turns: a maximum spanning forest of the votes (Kruskal; the strongest agreement or
@@ -580,22 +610,30 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     report.FlippedComponents += turned[m];
   }
 
-  // The final normals: as propagated in the block, turned with its node.
-  for (Index i = 0; i < n; ++i)
+  // The final normals: as propagated in the block, turned with its node (the halo's from their owners).
+  std::vector<double> turn(nodes.size());
+  for (size_t m = 0; m < nodes.size(); ++m)
   {
-    const double* st = &state[4 * i];
-    if (!(st[3] >= 1.0))
-    {
-      continue;
-    }
-    const size_t m = indexOf(nodeOf(i));
-    const double sign = st[0] * (parity[m] ? -1.0 : 1.0) * (turned[root[m]] ? -1.0 : 1.0);
-    for (int a = 0; a < 3; ++a)
-    {
-      field.Normals[3 * i + a] *= sign;
-    }
-    confidence[i] = rank[i] >= 0 && component[rank[i]] >= 0 ? sortedConfidence[rank[i]] : 0.0;
+    turn[m] = (parity[m] ? -1.0 : 1.0) * (turned[root[m]] ? -1.0 : 1.0);
   }
+  ParallelFor(static_cast<Index>(wanted.size()), 4, [&](Index b0, Index b1) {
+    for (Index b = b0; b < b1; ++b)
+    {
+      const size_t first = indexOf(Node{ wanted[b], 0 });
+      for (size_t m = blockBegin[b]; m < blockBegin[b + 1]; ++m)
+      {
+        const std::int32_t s = members[m].second;
+        const Index i = order[s];
+        const double sign = state[4 * i] * turn[first + static_cast<size_t>(component[s])];
+        for (int a = 0; a < 3; ++a)
+        {
+          field.Normals[3 * i + a] *= sign;
+        }
+        confidence[i] = sortedConfidence[s];
+      }
+    }
+  });
+  UpdateHalo(d, field.Normals, 3);
   // Outliers follow their nearest oriented neighbour.
   Index ambiguous = 0;
   for (Index i = 0; i < n; ++i)
