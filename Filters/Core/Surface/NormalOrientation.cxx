@@ -201,25 +201,36 @@ void ReduceNodes(const Distribution* d, const std::vector<Node>& localNodes,
   }
 }
 
+/// Votes (a, b, q) sorted and summed per pair (q: integers, exact in any order), appended to `links` (or
+/// replacing them).
+void SumVotes(std::vector<std::tuple<Node, Node, std::int64_t>>& votes,
+  std::vector<std::tuple<Node, Node, std::int64_t>>& links, bool append)
+{
+  std::sort(votes.begin(), votes.end());
+  if (!append)
+  {
+    links.clear();
+  }
+  const size_t first = links.size();
+  for (const auto& v : votes)
+  {
+    if (links.size() > first && std::get<0>(links.back()) == std::get<0>(v) &&
+      std::get<1>(links.back()) == std::get<1>(v))
+    {
+      std::get<2>(links.back()) += std::get<2>(v);
+    }
+    else
+    {
+      links.push_back(v);
+    }
+  }
+}
+
 /// Votes (a, b, q) -> one per pair, q added, every process' included; pairs sorted.
 void ReduceVotes(const Distribution* d, std::vector<std::tuple<Node, Node, std::int64_t>>& votes,
   std::vector<std::tuple<Node, Node, std::int64_t>>& links)
 {
-  auto reduce = [&]() {
-    std::sort(votes.begin(), votes.end());
-    links.clear();
-    for (const auto& v : votes)
-    {
-      if (!links.empty() && std::get<0>(links.back()) == std::get<0>(v) && std::get<1>(links.back()) == std::get<1>(v))
-      {
-        std::get<2>(links.back()) += std::get<2>(v);
-      }
-      else
-      {
-        links.push_back(v);
-      }
-    }
-  };
+  auto reduce = [&]() { SumVotes(votes, links, false); };
   reduce();
   if (!d)
   {
@@ -497,11 +508,17 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   // by block in parallel.
   std::vector<Node> localNodes(nodeBegin.back());
   std::vector<std::array<double, 8>> localSums(nodeBegin.back(), std::array<double, 8>{});
-  PerThread<std::vector<std::tuple<Node, Node, std::int64_t>>> threadVotes;
+  struct Votes
+  {
+    std::vector<std::tuple<Node, Node, std::int64_t>> Block, Kept; // one block's, and the reduced ones
+  };
+  PerThread<Votes> threadVotes;
   ParallelFor(static_cast<Index>(wanted.size()), 4, [&](Index b0, Index b1) {
-    std::vector<std::tuple<Node, Node, std::int64_t>>& votes = threadVotes.Local();
+    Votes& mine = threadVotes.Local();
+    std::vector<std::tuple<Node, Node, std::int64_t>>& votes = mine.Block;
     for (Index b = b0; b < b1; ++b)
     {
+      votes.clear();
       for (std::int64_t c = 0; c < blockComponents[b]; ++c)
       {
         localNodes[nodeBegin[b] + c] = Node{ wanted[b], c };
@@ -540,12 +557,14 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
           votes.emplace_back(std::min(a, other), std::max(a, other), std::llround(c * VoteScale));
         }
       }
+      // A block's edges vote for a few dozen pairs: reduced here (integer sums), the memory stays per block.
+      SumVotes(votes, mine.Kept, true);
     }
   });
   std::vector<std::tuple<Node, Node, std::int64_t>> votes;
-  for (const auto& mine : threadVotes)
+  for (const Votes& mine : threadVotes)
   {
-    votes.insert(votes.end(), mine.begin(), mine.end());
+    votes.insert(votes.end(), mine.Kept.begin(), mine.Kept.end());
   }
   // Reduced here, then over the processes (every process gets the same node list and votes).
   std::vector<Node> nodes;
