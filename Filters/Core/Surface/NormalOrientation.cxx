@@ -410,7 +410,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   std::vector<double> sortedConfidence(static_cast<size_t>(nv), 0.0);
   std::vector<unsigned char> done(static_cast<size_t>(nv), 0);
   std::vector<std::int32_t> parent(static_cast<size_t>(nv), -1);
-  std::vector<std::int64_t> component(static_cast<size_t>(nv), -1);
+  std::vector<std::int32_t> component(static_cast<size_t>(nv), -1);
   std::vector<float> key(static_cast<size_t>(nv), std::numeric_limits<float>::infinity());
   std::vector<std::int64_t> blockComponents(wanted.size(), 0);
   PerThread<BucketQueue> queues;
@@ -436,7 +436,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
             continue; // an entry left behind when its key was lowered
           }
           done[u] = 1;
-          component[u] = count;
+          component[u] = static_cast<std::int32_t>(count);
           double* nu = &normals[3 * u];
           if (parent[u] >= 0)
           {
@@ -481,15 +481,17 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     nodeBegin[b + 1] = nodeBegin[b] + static_cast<size_t>(blockComponents[b]);
   }
 
-  // Per point: its node (block, component) and whether the propagation turned it; the halo's from its owners.
-  std::vector<double> state(static_cast<size_t>(4 * n), 0.0);
-  ParallelFor(nv, 4096, [&](Index b0, Index b1) {
+  // Per point: whether the propagation turned it and its node (block, component). Serially from the blocks'
+  // arrays; distributed, in `state` (the halo's from their owners).
+  std::vector<double> state(d ? static_cast<size_t>(4 * n) : 0, 0.0);
+  auto turnedInBlock = [&](Index s) { return Dot(&normals[3 * s], &field.Normals[3 * order[s]]) < 0.0; };
+  ParallelFor(d ? nv : 0, 4096, [&](Index b0, Index b1) {
     for (Index s = b0; s < b1; ++s)
     {
       if (component[s] >= 0)
       {
         double* st = &state[4 * order[s]];
-        st[0] = Dot(&normals[3 * s], &field.Normals[3 * order[s]]) < 0.0 ? -1.0 : 1.0;
+        st[0] = turnedInBlock(s) ? -1.0 : 1.0;
         st[1] = static_cast<double>(blockOf[s] >> 32);
         st[2] = static_cast<double>(blockOf[s] & 0xffffffffull);
         st[3] = static_cast<double>(component[s] + 1); // 0: none
@@ -497,11 +499,17 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     }
   });
   UpdateHalo(d, state, 4);
-  auto nodeOf = [&state](Index id) {
+  auto hasNode = [&](Index id) { return d ? state[4 * id + 3] >= 1.0 : rank[id] >= 0 && component[rank[id]] >= 0; };
+  auto nodeOf = [&](Index id) {
+    if (!d)
+    {
+      return Node{ blockOf[rank[id]], component[rank[id]] };
+    }
     const double* st = &state[4 * id];
     return Node{ (static_cast<std::uint64_t>(st[1]) << 32) | static_cast<std::uint64_t>(st[2]),
       static_cast<std::int64_t>(st[3]) - 1 };
   };
+  auto signOf = [&](Index id) { return d ? state[4 * id] : (turnedInBlock(rank[id]) ? -1.0 : 1.0); };
 
   // Each node's sums over own points (count, position relative to the blocks' origin, turned normal, n . x) and
   // the votes of the graph's edges between nodes (n_i . n_j rounded to integers: exact sums in any order), block
@@ -544,7 +552,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
         for (int j = 0; j < k; ++j)
         {
           const std::int32_t v = field.Graph[static_cast<size_t>(id) * k + j];
-          if (v < 0 || state[4 * static_cast<size_t>(v) + 3] < 1.0)
+          if (v < 0 || !hasNode(v))
           {
             continue;
           }
@@ -553,7 +561,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
           {
             continue;
           }
-          const double c = state[4 * static_cast<size_t>(v)] * Dot(ni, &field.Normals[3 * static_cast<size_t>(v)]);
+          const double c = signOf(v) * Dot(ni, &field.Normals[3 * static_cast<size_t>(v)]);
           votes.emplace_back(std::min(a, other), std::max(a, other), std::llround(c * VoteScale));
         }
       }
@@ -643,7 +651,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       {
         const std::int32_t s = members[m].second;
         const Index i = order[s];
-        const double sign = state[4 * i] * turn[first + static_cast<size_t>(component[s])];
+        const double sign = signOf(i) * turn[first + static_cast<size_t>(component[s])];
         for (int a = 0; a < 3; ++a)
         {
           field.Normals[3 * i + a] *= sign;
