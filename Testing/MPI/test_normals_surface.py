@@ -8,7 +8,8 @@ ranks, --reference) with an independent `pvpython --no-mpi` run:
 - Normals: every point on exactly one rank, with its serial Normals, Curvature, SurfaceVariation,
   OrientationConfidence, vtkValidPointMask (and, with ProjectPoints, coordinates), bit for bit; also pieces that
   are slabs along x of a 40,000-point cloud, where no rank may hold more than a share of the cloud (its slab and
-  a halo band: LocalCloudPoints);
+  a halo band: LocalCloudPoints), three permutations of the cloud (split by index and in slabs) against the serial
+  run of the unpermuted cloud, and every point on the last rank;
 - Surface: the ranks' triangles together are the serial triangles, each exactly once: every triangle as its three
   vertices' (coordinates, Normals, approximated arrays), rotated to start at its smallest vertex, sorted, compared
   bit for bit.
@@ -40,7 +41,7 @@ import numpy as np
 from vtkmodules.util import numpy_support as ns
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as sddp
-count, split = {count}, '{split}'
+count, split, shuffle = {count}, '{split}', {shuffle}
 rng = np.random.default_rng(14)
 u, v = rng.random(count) * 2 * np.pi, rng.random(count) * 2 * np.pi
 R, r = 1.0, 0.4
@@ -48,6 +49,10 @@ xyz = np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u)
 xyz += rng.normal(scale=0.004, size=xyz.shape)
 if count > 100:
     xyz[-10:] = xyz[:10]                          # exact duplicates
+ident = np.arange(count, dtype=float)
+if shuffle:                                       # the same cloud in another order (Id follows its point)
+    perm = np.random.default_rng(shuffle).permutation(count)
+    xyz, ident = xyz[perm], ident[perm]
 info = self.GetOutputInformation(0)
 piece = info.Get(sddp.UPDATE_PIECE_NUMBER()) if info.Has(sddp.UPDATE_PIECE_NUMBER()) else 0
 pieces = info.Get(sddp.UPDATE_NUMBER_OF_PIECES()) if info.Has(sddp.UPDATE_NUMBER_OF_PIECES()) else 1
@@ -55,6 +60,8 @@ if pieces == 1:
     lo, hi = 0, count
 elif split in ('even', 'slab'):
     lo, hi = piece * count // pieces, (piece + 1) * count // pieces
+elif split == 'last':                             # every point on the last rank
+    lo, hi = (0, count) if piece == pieces - 1 else (0, 0)
 else:                                             # piece 0 empty, the others growing
     lo = 0 if piece == 0 else count * (piece - 1) ** 2 // (pieces - 1) ** 2
     hi = 0 if piece == 0 else count * piece ** 2 // (pieces - 1) ** 2
@@ -65,7 +72,7 @@ out = self.GetPolyDataOutput()
 pts = vtkPoints()
 pts.SetData(ns.numpy_to_vtk(np.ascontiguousarray(xyz[take]), deep=1))
 out.SetPoints(pts)
-for name, values in (('Id', np.arange(count, dtype=float)), ('Temperature', xyz[:, 2] + 0.5 * xyz[:, 0])):
+for name, values in (('Id', ident), ('Temperature', xyz[:, 2] + 0.5 * xyz[:, 0])):
     array = ns.numpy_to_vtk(np.ascontiguousarray(values[take]), deep=1)
     array.SetName(name)
     out.GetPointData().AddArray(array)
@@ -78,10 +85,10 @@ NORMAL_ARRAYS = ["Normals", "Curvature", "SurfaceVariation", "OrientationConfide
 SURFACE_ARRAYS = ["Normals", "Temperature", "vtkValidPointMask"]
 
 
-def cloud(count, split):
+def cloud(count, split, shuffle=0):
     simple.SetActiveSource(None)
     return simple.ProgrammableSource(OutputDataSetType="vtkPolyData",
-                                     Script=CLOUD_SCRIPT.format(count=count, split=split),
+                                     Script=CLOUD_SCRIPT.format(count=count, split=split, shuffle=shuffle),
                                      ScriptRequestInformation=INFO_SCRIPT)
 
 
@@ -137,9 +144,11 @@ def soup(polydata, names):
     return out[np.lexsort(out.T[::-1])] if len(out) else out
 
 
-def normals_case(label, count, split, max_share=1.0, **settings):
-    source = cloud(count, split)
-    normals, serial = MeshlessNormals(Input=source, **settings), MeshlessNormals(Input=source, **settings)
+def normals_case(label, count, split, max_share=1.0, shuffle=0, **settings):
+    # With shuffle, the pieces hold a permutation of the cloud; the serial run is of the cloud in its own order.
+    source = cloud(count, split, shuffle)
+    normals = MeshlessNormals(Input=source, **settings)
+    serial = MeshlessNormals(Input=cloud(count, split) if shuffle else source, **settings)
     local = mm.local_output(normals, 0.0)
     got = mm.gathered_points(local, NORMAL_ARRAYS)
     want = mm.sorted_rows(mm.rows(mm.serial_output(serial, 0.0), NORMAL_ARRAYS))
@@ -201,6 +210,13 @@ for piece_split in ("even", "uneven"):
 # on 3 the middle slab and its two bands 72 % (the gathered cloud was 100 %).
 normals_case("slabs", 40000, "slab", max_share=0.7 if mm.RANKS == 2 else 0.8)
 normals_case("slabs_projected", 40000, "slab", max_share=0.85 if mm.RANKS == 2 else 0.9, ProjectPoints=1)
+
+# The order of the points does not matter: three permutations of the cloud, split by index and in slabs, equal the
+# serial run of the cloud in its own order (Id follows each point).
+for seed in (1, 2, 3):
+    normals_case(f"shuffled_{seed}", 3000, "even" if seed < 3 else "slab", shuffle=seed)
+# Every point on one rank, the others empty.
+normals_case("all_on_last_rank", 3000, "last")
 
 # One point: no hang, nothing computed, the point on exactly one rank.
 normals_case("one_point", 1, "even")
