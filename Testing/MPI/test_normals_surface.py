@@ -9,7 +9,7 @@ ranks, --reference) with an independent `pvpython --no-mpi` run:
   OrientationConfidence, vtkValidPointMask (and, with ProjectPoints, coordinates), bit for bit; also pieces that
   are slabs along x of a 40,000-point cloud, where no rank may hold more than a share of the cloud (its slab and
   a halo band: LocalCloudPoints), three permutations of the cloud (split by index and in slabs) against the serial
-  run of the unpermuted cloud, and every point on the last rank;
+  run of the unpermuted cloud, pieces from RedistributeDataSet, and every point on the last rank;
 - Surface: the ranks' triangles together are the serial triangles, each exactly once: every triangle as its three
   vertices' (coordinates, Normals, approximated arrays), rotated to start at its smallest vertex, sorted, compared
   bit for bit.
@@ -40,6 +40,7 @@ CLOUD_SCRIPT = """
 import numpy as np
 from vtkmodules.util import numpy_support as ns
 from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkCellArray
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as sddp
 count, split, shuffle = {count}, '{split}', {shuffle}
 rng = np.random.default_rng(14)
@@ -47,8 +48,8 @@ u, v = rng.random(count) * 2 * np.pi, rng.random(count) * 2 * np.pi
 R, r = 1.0, 0.4
 xyz = np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], -1)
 xyz += rng.normal(scale=0.004, size=xyz.shape)
-if count > 100:
-    xyz[-10:] = xyz[:10]                          # exact duplicates
+if count > 100 and split != 'redistribute':      # exact duplicates (RedistributeDataSet merges them)
+    xyz[-10:] = xyz[:10]
 ident = np.arange(count, dtype=float)
 if shuffle:                                       # the same cloud in another order (Id follows its point)
     perm = np.random.default_rng(shuffle).permutation(count)
@@ -58,7 +59,7 @@ piece = info.Get(sddp.UPDATE_PIECE_NUMBER()) if info.Has(sddp.UPDATE_PIECE_NUMBE
 pieces = info.Get(sddp.UPDATE_NUMBER_OF_PIECES()) if info.Has(sddp.UPDATE_NUMBER_OF_PIECES()) else 1
 if pieces == 1:
     lo, hi = 0, count
-elif split in ('even', 'slab'):
+elif split in ('even', 'slab', 'redistribute'):
     lo, hi = piece * count // pieces, (piece + 1) * count // pieces
 elif split == 'last':                             # every point on the last rank
     lo, hi = (0, count) if piece == pieces - 1 else (0, 0)
@@ -72,6 +73,11 @@ out = self.GetPolyDataOutput()
 pts = vtkPoints()
 pts.SetData(ns.numpy_to_vtk(np.ascontiguousarray(xyz[take]), deep=1))
 out.SetPoints(pts)
+if split == 'redistribute':                       # RedistributeDataSet drops points without cells
+    verts = vtkCellArray()
+    verts.SetData(ns.numpy_to_vtk(np.arange(len(take) + 1, dtype=np.int64), deep=1),
+                  ns.numpy_to_vtk(np.arange(len(take), dtype=np.int64), deep=1))
+    out.SetVerts(verts)
 for name, values in (('Id', ident), ('Temperature', xyz[:, 2] + 0.5 * xyz[:, 0])):
     array = ns.numpy_to_vtk(np.ascontiguousarray(values[take]), deep=1)
     array.SetName(name)
@@ -147,7 +153,9 @@ def soup(polydata, names):
 def normals_case(label, count, split, max_share=1.0, shuffle=0, **settings):
     # With shuffle, the pieces hold a permutation of the cloud; the serial run is of the cloud in its own order.
     source = cloud(count, split, shuffle)
-    normals = MeshlessNormals(Input=source, **settings)
+    # redistribute: ParaView's RedistributeDataSet makes spatial pieces (the serial run takes the source itself).
+    pieces = simple.RedistributeDataSet(Input=source) if split == "redistribute" else source
+    normals = MeshlessNormals(Input=pieces, **settings)
     serial = MeshlessNormals(Input=cloud(count, split) if shuffle else source, **settings)
     local = mm.local_output(normals, 0.0)
     got = mm.gathered_points(local, NORMAL_ARRAYS)
@@ -166,14 +174,14 @@ def normals_case(label, count, split, max_share=1.0, shuffle=0, **settings):
         return normals
     held = local.GetFieldData().GetArray("LocalCloudPoints")
     mm.check(held is not None and held.GetTuple1(0) <= count, f"Normals {label}: LocalCloudPoints missing or > {count}")
-    if split == "slab":
+    if split in ("slab", "redistribute"):
         most = mm.all_gather(np.array([[held.GetTuple1(0)]]))[:, 0].max()
         radius = local.GetFieldData().GetArray("HaloRadius").GetTuple1(0)
         attempts = local.GetFieldData().GetArray("HaloAttempts").GetTuple1(0)
         if mm.RANK == 0:
-            mm.log(f"Normals {label} (slabs): at most {int(most)} of {count} points on a rank "
+            mm.log(f"Normals {label} ({split}): at most {int(most)} of {count} points on a rank "
                    f"(halo radius {radius:.3g}, {int(attempts)} attempt(s))")
-        mm.check(most <= max_share * count, f"Normals {label} (slabs): a rank held {most} of {count} points")
+        mm.check(most <= max_share * count, f"Normals {label} ({split}): a rank held {most} of {count} points")
     return normals
 
 
@@ -215,6 +223,8 @@ normals_case("slabs_projected", 40000, "slab", max_share=0.85 if mm.RANKS == 2 e
 # serial run of the cloud in its own order (Id follows each point).
 for seed in (1, 2, 3):
     normals_case(f"shuffled_{seed}", 3000, "even" if seed < 3 else "slab", shuffle=seed)
+# Spatial pieces from ParaView's RedistributeDataSet (no GlobalIds: the halo numbers the points rank by rank).
+normals_case("redistributed", 20000, "redistribute", max_share=0.8 if mm.RANKS == 2 else 0.9)
 # Every point on one rank, the others empty.
 normals_case("all_on_last_rank", 3000, "last")
 
