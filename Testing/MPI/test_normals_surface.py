@@ -225,6 +225,8 @@ for seed in (1, 2, 3):
     normals_case(f"shuffled_{seed}", 3000, "even" if seed < 3 else "slab", shuffle=seed)
 # Spatial pieces from ParaView's RedistributeDataSet (no GlobalIds: the halo numbers the points rank by rank).
 normals_case("redistributed", 20000, "redistribute", max_share=0.8 if mm.RANKS == 2 else 0.9)
+# A fixed neighbourhood radius (no scale estimate) in slabs.
+normals_case("fixed_radius", 3000, "slab", SupportRadius=0.15)
 # Every point on one rank, the others empty.
 normals_case("all_on_last_rank", 3000, "last")
 
