@@ -42,7 +42,7 @@ from vtkmodules.util import numpy_support as ns
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as sddp
-count, split, shuffle = {count}, '{split}', {shuffle}
+count, split, shuffle, nans = {count}, '{split}', {shuffle}, {nans}
 rng = np.random.default_rng(14)
 u, v = rng.random(count) * 2 * np.pi, rng.random(count) * 2 * np.pi
 R, r = 1.0, 0.4
@@ -51,6 +51,8 @@ xyz += rng.normal(scale=0.004, size=xyz.shape)
 if count > 100 and split != 'redistribute':      # exact duplicates (RedistributeDataSet merges them)
     xyz[-10:] = xyz[:10]
 ident = np.arange(count, dtype=float)
+if nans:                                          # points with a NaN coordinate: invalid, never in a halo
+    xyz[np.arange(nans) * (count // nans), 1] = np.nan
 if shuffle:                                       # the same cloud in another order (Id follows its point)
     perm = np.random.default_rng(shuffle).permutation(count)
     xyz, ident = xyz[perm], ident[perm]
@@ -91,10 +93,10 @@ NORMAL_ARRAYS = ["Normals", "Curvature", "SurfaceVariation", "OrientationConfide
 SURFACE_ARRAYS = ["Normals", "Temperature", "vtkValidPointMask"]
 
 
-def cloud(count, split, shuffle=0):
+def cloud(count, split, shuffle=0, nans=0):
     simple.SetActiveSource(None)
     return simple.ProgrammableSource(OutputDataSetType="vtkPolyData",
-                                     Script=CLOUD_SCRIPT.format(count=count, split=split, shuffle=shuffle),
+                                     Script=CLOUD_SCRIPT.format(count=count, split=split, shuffle=shuffle, nans=nans),
                                      ScriptRequestInformation=INFO_SCRIPT)
 
 
@@ -108,11 +110,14 @@ def agree(value, what):
 
 
 def compare(label, got, want):
-    """Bitwise (see the module's doc); --measure: report only."""
+    """Bitwise (see the module's doc), NaN where the serial run has NaN (a NaN input point's coordinates); --measure:
+    report only."""
     if got.shape != want.shape:
         mm.log(f"{label}: shape {got.shape} on {mm.RANKS} ranks, serial {want.shape}")
         mm.check(MEASURE, f"{label}: shapes differ")
         return
+    mm.check(MEASURE or np.array_equal(np.isnan(got), np.isnan(want)), f"{label}: NaN in other places than serial")
+    got, want = np.nan_to_num(got, nan=0.0), np.nan_to_num(want, nan=0.0)
     diff = np.abs(got - want)
     if MEASURE:
         if mm.RANK == 0:
@@ -150,13 +155,13 @@ def soup(polydata, names):
     return out[np.lexsort(out.T[::-1])] if len(out) else out
 
 
-def normals_case(label, count, split, max_share=1.0, shuffle=0, **settings):
+def normals_case(label, count, split, max_share=1.0, shuffle=0, nans=0, **settings):
     # With shuffle, the pieces hold a permutation of the cloud; the serial run is of the cloud in its own order.
-    source = cloud(count, split, shuffle)
+    source = cloud(count, split, shuffle, nans)
     # redistribute: ParaView's RedistributeDataSet makes spatial pieces (the serial run takes the source itself).
     pieces = simple.RedistributeDataSet(Input=source) if split == "redistribute" else source
     normals = MeshlessNormals(Input=pieces, **settings)
-    serial = MeshlessNormals(Input=cloud(count, split) if shuffle else source, **settings)
+    serial = MeshlessNormals(Input=cloud(count, split, 0, nans) if shuffle else source, **settings)
     local = mm.local_output(normals, 0.0)
     got = mm.gathered_points(local, NORMAL_ARRAYS)
     want = mm.sorted_rows(mm.rows(mm.serial_output(serial, 0.0), NORMAL_ARRAYS))
@@ -225,6 +230,8 @@ for seed in (1, 2, 3):
     normals_case(f"shuffled_{seed}", 3000, "even" if seed < 3 else "slab", shuffle=seed)
 # Spatial pieces from ParaView's RedistributeDataSet (no GlobalIds: the halo numbers the points rank by rank).
 normals_case("redistributed", 20000, "redistribute", max_share=0.8 if mm.RANKS == 2 else 0.9)
+# Points with NaN coordinates (no normal, vtkValidPointMask 0), split by index.
+normals_case("with_nan", 3000, "even", nans=7)
 # A fixed neighbourhood radius (no scale estimate) in slabs.
 normals_case("fixed_radius", 3000, "slab", SupportRadius=0.15)
 # Every point on one rank, the others empty.
