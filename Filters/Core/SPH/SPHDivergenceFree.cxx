@@ -176,14 +176,16 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
     [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
-        rho[i] = SPHParticleDensity(i, x, fs, fn, bx, bs, bn, dc);
-        this->InverseDensity[i] = 1.0 / rho[i];
         const double* xi = x + 3 * i;
         double sum[3] = { 0.0, 0.0, 0.0 }, wallSum[3] = { 0.0, 0.0, 0.0 }, squares = 0.0;
-        // m grad W_ij = -G_ij, G_ij = coefficient (x_i - x_j), coefficient = m GradientNorm shape(r) >= 0.
+        // The density (the kernel sum over the same pairs in the same order as SPHParticleDensity: the same bits)
+        // and, in the same pass, m grad W_ij = -G_ij, G_ij = coefficient (x_i - x_j), coefficient = m GradientNorm
+        // shape(r) >= 0.
+        SPHDensitySum density(dc);
         auto coefficient = [&](const double* xj, double* out) {
           const double r[3] = { xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2] };
           const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+          density.Add(r2, dc);
           double k = 0.0;
           if (r2 < c.H2 && r2 > 0.0)
           {
@@ -215,6 +217,8 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
         {
           wallSum[a] = sum[a] - fluidSum[a];
         }
+        rho[i] = density.Density(dc);
+        this->InverseDensity[i] = 1.0 / rho[i];
         // The particle's own kappa pushes it by (sum_f G + 2 sum_b G) (the mirrored wall pressure counts twice)
         // and its fluid neighbours by -G_ij; its density rate counts the mirrored dummies twice as well (below):
         // the rate changes by -dt kappa_i / rho_i (|sum_f G + 2 sum_b G|^2 + sum_f |G_ij|^2).
