@@ -3,8 +3,10 @@
 // Threads: all the CPUs, or MESHFREE_NUM_THREADS (OMP_NUM_THREADS is honoured too).
 //
 // BenchSPH --solver dfsph [--sizes 65536] [seconds]: the same 3D dam breaks with the DFSPH solver at its default
-// tolerances and step rule (CFLNumber 0.25, TimeStep 1 ms), also reporting wall-clock seconds per simulated second
-// and the solves' iterations per step; --sizes picks among 16,384, 65,536 and 262,144 particles.
+// tolerances and step rule (CFLNumber 0.25, TimeStep 1 ms), also reporting the solves' iterations per step; --sizes
+// picks among 16,384, 65,536 and 262,144 particles. Both solvers report wall-clock seconds per simulated second.
+// --warmup F: simulate F x seconds untimed first (default 0.2: buffers grown, flow started); --warmup 0 times the
+// run from the initial state, as bench_splishsplash.py does for the comparison with SPlisHSPlasH.
 //
 // BenchSPH --backend cuda [--steps N] [--sizes 65536,1048576,4194304]: the CUDA device integrator
 // (SPHFluid::SetBackend(CUDA)) beside the CPU on 3D dam breaks (double) of 65,536, 1,048,576 and 4,194,304
@@ -121,6 +123,7 @@ int main(int argc, char* argv[])
   std::string backend = "cpu";
   long steps = 50;
   std::vector<long> sizes = { 65536, 1048576, 4194304 };
+  double warmup = 0.2;
   bool sizesGiven = false, dfsph = false;
   for (int k = 1; k < argc; ++k)
   {
@@ -142,6 +145,10 @@ int main(int argc, char* argv[])
         return 2;
       }
       dfsph = solver == "dfsph";
+    }
+    else if (a == "--warmup" && k + 1 < argc)
+    {
+      warmup = std::max(0.0, std::atof(argv[++k]));
     }
     else if (a == "--sizes" && k + 1 < argc)
     {
@@ -168,9 +175,10 @@ int main(int argc, char* argv[])
     return DeviceBenchmark(steps, sizes);
   }
   const int blocks[3][3] = { { 32, 16, 32 }, { 64, 32, 32 }, { 64, 64, 64 } };
-  const char* dfsphColumns = "  wall s/sim s  density/divergence iterations per step";
-  std::printf("%s%s\n%10s %8s %12s %14s %12s%s\n", meshfree::ParallelBackend(), dfsph ? ", DFSPH" : "", "particles",
-    "steps", "seconds", "psteps/s", "neighbours", dfsph ? dfsphColumns : "");
+  const char* dfsphColumns = "  density/divergence iterations per step";
+  std::printf("%s%s\n%10s %8s %12s %12s %14s %12s %13s%s\n", meshfree::ParallelBackend(),
+    dfsph ? ", DFSPH" : ", WCSPH", "particles", "steps", "sim s", "seconds", "psteps/s",
+    "neighbours", "wall s/sim s", dfsph ? dfsphColumns : "");
   for (const auto& b : blocks)
   {
     const long count = static_cast<long>(b[0]) * b[1] * b[2];
@@ -197,11 +205,14 @@ int main(int argc, char* argv[])
     meshfree::SPHFluid solver;
     solver.Setup(p);
     meshfree::SPHState state = solver.InitialState();
-    solver.Advance(state, 0.2 * span); // warm up: buffers grown, flow started
+    if (warmup > 0.0)
+    {
+      solver.Advance(state, warmup * span); // warm up: buffers grown, flow started
+    }
     const long first = state.Steps;
     const double firstTime = state.Time;
     const auto start = std::chrono::steady_clock::now();
-    solver.Advance(state, 1.2 * span);
+    solver.Advance(state, (warmup + 1.0) * span);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const long steps = state.Steps - first;
     double neighbours = 0.0;
@@ -209,11 +220,12 @@ int main(int argc, char* argv[])
     {
       neighbours += c;
     }
-    std::printf("%10ld %8ld %12.3f %14.4g %12.1f", static_cast<long>(state.Size()), steps, seconds,
-      static_cast<double>(steps) * state.Size() / seconds, neighbours / state.Size());
+    std::printf("%10ld %8ld %12.4f %12.3f %14.4g %12.1f %13.1f", static_cast<long>(state.Size()), steps,
+      state.Time - firstTime, seconds, static_cast<double>(steps) * state.Size() / seconds, neighbours / state.Size(),
+      seconds / (state.Time - firstTime));
     if (dfsph)
     {
-      std::printf("  %12.1f  %.2f / %.2f", seconds / (state.Time - firstTime),
+      std::printf("  %.2f / %.2f",
         static_cast<double>(state.Report.DensityIterations) / std::max(1L, state.Report.Steps),
         static_cast<double>(state.Report.DivergenceIterations) / std::max(1L, state.Report.Steps));
     }

@@ -161,27 +161,31 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
   state.Density.resize(n);
   this->InverseDensity.resize(n);
   this->Alpha.resize(n);
-  this->PairCoefficient.resize(fs[n]);
+  this->PairGradient.resize(3 * fs[n]);
   this->WallCoefficient.resize(bs[n]);
+  this->SelfGradient.resize(3 * n);
   const SPHConstants& c = this->Physics;
   const SPHDensityConstants dc = SPHDensityConstantsOf(c);
   const double cutoff = 1e-9 * this->LatticeFactorSum;
   double* rho = state.Density.data();
-  double* pair = this->PairCoefficient.data();
+  double* pair = this->PairGradient.data();
   double* wall = this->WallCoefficient.data();
+  double* self = this->SelfGradient.data();
   ParallelFor(
     n, 512,
     [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i)
       {
-        rho[i] = SPHParticleDensity(i, x, fs, fn, bx, bs, bn, dc);
-        this->InverseDensity[i] = 1.0 / rho[i];
         const double* xi = x + 3 * i;
         double sum[3] = { 0.0, 0.0, 0.0 }, wallSum[3] = { 0.0, 0.0, 0.0 }, squares = 0.0;
-        // m grad W_ij = -G_ij, G_ij = coefficient (x_i - x_j), coefficient = m GradientNorm shape(r) >= 0.
+        // The density (the kernel sum over the same pairs in the same order as SPHParticleDensity: the same bits)
+        // and, in the same pass, m grad W_ij = -G_ij, G_ij = coefficient (x_i - x_j), coefficient = m GradientNorm
+        // shape(r) >= 0.
+        SPHDensitySum density(dc);
         auto coefficient = [&](const double* xj, double* out) {
           const double r[3] = { xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2] };
           const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+          density.Add(r2, dc);
           double k = 0.0;
           if (r2 < c.H2 && r2 > 0.0)
           {
@@ -196,7 +200,13 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
         };
         for (Index s = fs[i]; s < fs[i + 1]; ++s)
         {
-          squares += coefficient(x + 3 * static_cast<Index>(fn[s]), pair + s);
+          const double* xj = x + 3 * static_cast<Index>(fn[s]);
+          double k;
+          squares += coefficient(xj, &k);
+          for (int a = 0; a < 3; ++a)
+          {
+            pair[3 * s + a] = k * (xi[a] - xj[a]);
+          }
         }
         const double fluidSum[3] = { sum[0], sum[1], sum[2] };
         for (Index s = bs[i]; s < bs[i + 1]; ++s)
@@ -207,11 +217,17 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
         {
           wallSum[a] = sum[a] - fluidSum[a];
         }
+        rho[i] = density.Density(dc);
+        this->InverseDensity[i] = 1.0 / rho[i];
         // The particle's own kappa pushes it by (sum_f G + 2 sum_b G) (the mirrored wall pressure counts twice)
         // and its fluid neighbours by -G_ij; its density rate counts the mirrored dummies twice as well (below):
         // the rate changes by -dt kappa_i / rho_i (|sum_f G + 2 sum_b G|^2 + sum_f |G_ij|^2).
         const double mirrored[3] = { fluidSum[0] + 2.0 * wallSum[0], fluidSum[1] + 2.0 * wallSum[1],
           fluidSum[2] + 2.0 * wallSum[2] };
+        for (int a = 0; a < 3; ++a)
+        {
+          self[3 * i + a] = mirrored[a];
+        }
         const double total =
           mirrored[0] * mirrored[0] + mirrored[1] * mirrored[1] + mirrored[2] * mirrored[2] + squares;
         // Bounded below: the mirrored wall term can nearly cancel the first product for a particle wedged in a
@@ -268,16 +284,12 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
   const SPHParameters& p = this->Params;
   const Index n = state.Size();
   const Index* fs = this->FluidStart.data();
-  const Index* bs = this->BoundaryStart.data();
   const std::int32_t* fn = this->FluidNeighbors.data();
-  const std::int32_t* bn = this->BoundaryNeighbors.data();
-  const double* x = state.Position.data();
-  const double* bx = this->BoundaryPosition.data();
   const double* rho = state.Density.data();
   const double* inverse = this->InverseDensity.data();
   const double* alpha = this->Alpha.data();
-  const double* pair = this->PairCoefficient.data();
-  const double* wall = this->WallCoefficient.data();
+  const double* pair = this->PairGradient.data();
+  const double* self = this->SelfGradient.data();
   double* v = state.Velocity.data();
   std::vector<double>& stored = density ? state.DensityStiffness : state.DivergenceStiffness;
   stored.resize(n, 0.0);
@@ -306,31 +318,28 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
   const bool flat = p.Dimension == 2;
 
   // out_i (+)= (B w)_i = sum_j (w_i + w_j) G_ij + sum_b 2 w_i G_ib (G = -m grad W): the velocity change of the
-  // impulse potentials w = P / rho (mirrored walls: p_b = p_i, rho_b = rho_i).
+  // impulse potentials w = P / rho (mirrored walls: p_b = p_i, rho_b = rho_i), computed as
+  // w_i (sum_j G_ij + 2 sum_b G_ib) + sum_j w_j G_ij with the pair gradients and own sums of DivergenceFreeFields
+  // (the solves' passes then read no positions and no wall pairs: they were two thirds of a DFSPH step).
   auto impulse = [&](const double* w, double* out, bool add) {
     ParallelFor(
       n, 512,
       [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
-          const double* xi = x + 3 * i;
           double dv[3] = { 0.0, 0.0, 0.0 };
           for (Index s = fs[i]; s < fs[i + 1]; ++s)
           {
-            const double* xj = x + 3 * static_cast<Index>(fn[s]);
-            const double k = pair[s] * (w[i] + w[fn[s]]);
-            dv[0] += k * (xi[0] - xj[0]);
-            dv[1] += k * (xi[1] - xj[1]);
-            dv[2] += k * (xi[2] - xj[2]);
+            const double wj = w[fn[s]];
+            const double* gs = pair + 3 * s;
+            dv[0] += wj * gs[0];
+            dv[1] += wj * gs[1];
+            dv[2] += wj * gs[2];
           }
-          for (Index s = bs[i]; s < bs[i + 1]; ++s)
-          {
-            const double* xb = bx + 3 * static_cast<Index>(bn[s]);
-            const double k = 2.0 * wall[s] * w[i]; // mirrored: p_b = p_i, rho_b = rho_i
-            dv[0] += k * (xi[0] - xb[0]);
-            dv[1] += k * (xi[1] - xb[1]);
-            dv[2] += k * (xi[2] - xb[2]);
-          }
+          const double* gi = self + 3 * i;
+          dv[0] += w[i] * gi[0];
+          dv[1] += w[i] * gi[1];
+          dv[2] += w[i] * gi[2];
           if (flat)
           {
             dv[1] = 0.0;
@@ -360,24 +369,19 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
       [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
-          const double* xi = x + 3 * i;
+          // Drho/Dt = sum_j m (v_i - v_j) . grad W_ij = -sum_j (v_i - v_j) . G_ij - sum_b 2 v_i . G_ib: the
+          // mirrored dummy moves with -v_i (as its pressure is p_i), the adjoint of the push's factor 2; computed
+          // as sum_j v_j . G_ij - v_i . (sum_j G_ij + 2 sum_b G_ib).
           const double* vi = vel + 3 * i;
-          double rate = 0.0; // Drho/Dt = sum_j m (v_i - v_j) . grad W_ij = -sum_j (v_i - v_j) . G_ij
+          double rate = 0.0;
           for (Index s = fs[i]; s < fs[i + 1]; ++s)
           {
-            const Index j = fn[s];
-            const double* xj = x + 3 * j;
-            const double* vj = vel + 3 * j;
-            rate -= pair[s] *
-              ((vi[0] - vj[0]) * (xi[0] - xj[0]) + (vi[1] - vj[1]) * (xi[1] - xj[1]) +
-                (vi[2] - vj[2]) * (xi[2] - xj[2]));
+            const double* vj = vel + 3 * static_cast<Index>(fn[s]);
+            const double* gs = pair + 3 * s;
+            rate += vj[0] * gs[0] + vj[1] * gs[1] + vj[2] * gs[2];
           }
-          for (Index s = bs[i]; s < bs[i + 1]; ++s)
-          {
-            // The mirrored dummy moves with -v_i (as its pressure is p_i): the adjoint of the push's factor 2.
-            const double* xb = bx + 3 * static_cast<Index>(bn[s]);
-            rate -= 2.0 * wall[s] * (vi[0] * (xi[0] - xb[0]) + vi[1] * (xi[1] - xb[1]) + vi[2] * (xi[2] - xb[2]));
-          }
+          const double* gi = self + 3 * i;
+          rate -= vi[0] * gi[0] + vi[1] * gi[1] + vi[2] * gi[2];
           out[i] = density ? (offset ? std::min(rho[i] - rho0, overlap) : 0.0) + dt * rate : rate;
         }
       },

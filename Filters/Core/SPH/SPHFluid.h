@@ -309,7 +309,9 @@ private:
   void DivergenceFreeOutput(SPHState& state);
   bool ChooseDivergenceFreeStep(const SPHState& state, double time, double targetTime, long steps, double& dt,
     bool& last);
-  std::vector<double> PairCoefficient, WallCoefficient; // m GradientNorm shape(r) of every fluid and wall pair
+  // G_ij = m GradientNorm shape(r) (x_i - x_j) of every fluid pair (3 per pair, in the CSR rows' order), the wall
+  // pairs' coefficients m GradientNorm shape(r), and each particle's own sum_f G + 2 sum_b G (3 per particle).
+  std::vector<double> PairGradient, WallCoefficient, SelfGradient;
   std::vector<double> Alpha, Kappa, KappaOverRho, OldCompression, OldVelocity, Smoothed;
   std::vector<double> SolveResidual, SolveDirection, SolvePreconditioned, SolveProduct, SolveVelocity; // the CG's
   std::vector<char> SolveFree;
