@@ -58,6 +58,9 @@ ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 
 BLOCKS = {16384: (32, 16, 32), 65536: (64, 32, 32), 262144: (64, 64, 64)}  # as BenchSPH
 DX = 0.01
+# The DFSPH tolerances (0.01 % density, 0.1 % divergence, as MeshFree's defaults) and iteration bounds.
+DFSPH_SETTINGS = {"minIterations": 2, "maxIterations": 100, "maxError": 0.01, "maxIterationsV": 100, "maxErrorV": 0.1,
+                  "enableDivergenceSolver": True}
 
 
 def scene(size, end, boundary, box_obj):
@@ -87,20 +90,8 @@ def scene(size, end, boundary, box_obj):
             "enableRigidBodyVTKExport": False,
             # SPlisHSPlasH <= 2.15 reads the solver's settings from Configuration itself, 2.16 from a block named
             # after the method: both are written.
-            "minIterations": 2,
-            "maxIterations": 100,
-            "maxError": 0.01,
-            "maxIterationsV": 100,
-            "maxErrorV": 0.1,
-            "enableDivergenceSolver": True,
-            "DFSPH": {
-                "minIterations": 2,
-                "maxIterations": 100,
-                "maxError": 0.01,
-                "maxIterationsV": 100,
-                "maxErrorV": 0.1,
-                "enableDivergenceSolver": True,
-            },
+            **DFSPH_SETTINGS,
+            "DFSPH": dict(DFSPH_SETTINGS),
         },
         "Materials": [
             {
