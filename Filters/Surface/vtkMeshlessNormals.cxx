@@ -43,8 +43,9 @@ const char* OrientationName(int orientation)
   return orientation >= 0 && orientation < 4 ? names[orientation] : "?";
 }
 
-/// Median of the first n values whose mask is set (0 when none is), over every rank's.
-double MaskedMedian(vtkMultiProcessController* controller, const std::vector<double>& values,
+/// The median of the first n values whose mask is set (0 when none is), over every process of `processes` (null:
+/// this one's; distributed: an exact selection, no gather).
+double MaskedMedian(const meshfree::Distribution* processes, const std::vector<double>& values,
   const std::vector<unsigned char>& mask, vtkIdType n)
 {
   std::vector<double> kept;
@@ -55,13 +56,18 @@ double MaskedMedian(vtkMultiProcessController* controller, const std::vector<dou
       kept.push_back(values[i]);
     }
   }
-  if (!vtkMeshFreeHalo::IsDistributed(controller))
-  {
-    return meshfree::Median(std::move(kept));
-  }
-  // A small gather: the reported median only.
-  return meshfree::Median(vtkMeshFreePieces::AllGather(controller, kept));
+  return meshfree::GlobalMedian(processes, std::move(kept));
 }
+
+/// What a distributed run held: its piece and halo (points), the halo's radius and the attempts it took; and the
+/// median neighbourhood radius of the whole cloud (field data SupportRadius).
+struct HaloRun
+{
+  vtkIdType Held = 0;
+  double Radius = 0.0;
+  int Attempts = 0;
+  double MedianRadius = 0.0;
+};
 
 /// The halo's first radius: this many times the distance to the k-th nearest point (below).
 constexpr double HaloNeighborhoods = 8.0;
@@ -91,11 +97,10 @@ double LocalNeighborDistance(const double* xyz, vtkIdType n, int k)
 }
 /// Distributed (collective): this rank's points with a halo from the others (vtkMeshFreeHalo), the core computing
 /// its own points' results (their first `input` points), with the same bits as a serial run. referenceNormals
-/// (reference orientation) is given or not on every rank alike (an empty rank passes an empty array). `held` gets
-/// the number of points this rank computed over.
+/// (reference orientation) is given or not on every rank alike (an empty rank passes an empty array).
 bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* controller, vtkPointSet* input,
   vtkDataArray* referenceNormals, meshfree::CloudNormalsOptions& options, meshfree::CloudNormalsResult& result,
-  vtkIdType& held, double& haloRadius, int& attempts)
+  HaloRun& run)
 {
   // This rank's points (and reference normals), with the input's global ids when it has them.
   const vtkIdType n = input->GetNumberOfPoints();
@@ -151,12 +156,13 @@ bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* con
       radius = std::numeric_limits<double>::infinity();
     }
     halo->Exchange(mine, region, radius);
-    haloRadius = radius;
-    attempts = attempt + 1;
+    run.Radius = radius;
+    run.Attempts = attempt + 1;
     vtkMeshFreeHaloDistribution processes(controller, halo, region, radius);
     options.Neighborhood.Processes = &processes;
     vtkPolyData* cloud = halo->GetOutput();
-    held = cloud->GetNumberOfPoints();
+    const vtkIdType held = cloud->GetNumberOfPoints();
+    run.Held = held;
     const double* local = vtkDoubleArray::SafeDownCast(cloud->GetPoints()->GetData())->GetPointer(0);
     vtkDoubleArray* reference =
       referenceNormals ? vtkDoubleArray::SafeDownCast(cloud->GetPointData()->GetArray(kNormals)) : nullptr;
@@ -173,6 +179,7 @@ bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* con
     }
     if (!(shortfall > 0.0) || std::isinf(radius))
     {
+      run.MedianRadius = MaskedMedian(&processes, result.Radius, result.Valid, n);
       return true;
     }
     radius = std::max(radius + 1.25 * shortfall, 1.5 * radius);
@@ -250,9 +257,7 @@ int vtkMeshlessNormals::RequestData(
   options.ProjectionIterations = this->ProjectionIterations;
   meshfree::CloudNormalsResult result;
   bool done = false;
-  vtkIdType held = n; // the points this rank computed over (own and halo), the halo's radius, the attempts
-  double haloRadius = 0.0;
-  int attempts = 0;
+  HaloRun run; // distributed: what this rank held, and the whole cloud's median radius
   if (!distributed)
   {
     std::vector<double> xyz(3 * static_cast<size_t>(n)), reference(useReference ? 3 * static_cast<size_t>(n) : 0);
@@ -272,7 +277,7 @@ int vtkMeshlessNormals::RequestData(
     vtkNew<vtkDoubleArray> none; // an empty piece's reference: the same orientation mode as the other ranks'
     none->SetNumberOfComponents(3);
     vtkDataArray* reference = useReference ? (inputNormals ? inputNormals : none.GetPointer()) : nullptr;
-    done = ComputeDistributed(this, controller, input, reference, options, result, held, haloRadius, attempts);
+    done = ComputeDistributed(this, controller, input, reference, options, result, run);
   }
   if (!done || result.Aborted)
   {
@@ -337,7 +342,8 @@ int vtkMeshlessNormals::RequestData(
   // Field data: of the whole cloud, the same on every rank.
   vtkFieldData* fd = output->GetFieldData();
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "NoiseEstimate", result.Scale.Noise);
-  vtkMeshFreeFilterSupport::AddFieldValue(fd, "SupportRadius", MaskedMedian(controller, result.Radius, result.Valid, n));
+  vtkMeshFreeFilterSupport::AddFieldValue(
+    fd, "SupportRadius", distributed ? run.MedianRadius : MaskedMedian(nullptr, result.Radius, result.Valid, n));
   vtkNew<vtkIdTypeArray> ambiguous;
   ambiguous->SetName("AmbiguousOrientations");
   ambiguous->InsertNextValue(static_cast<vtkIdType>(result.Orientation.Ambiguous));
@@ -347,12 +353,12 @@ int vtkMeshlessNormals::RequestData(
     // This rank's own, per rank: how many points it computed over (its piece and its halo).
     vtkNew<vtkIdTypeArray> local;
     local->SetName("LocalCloudPoints");
-    local->InsertNextValue(held);
+    local->InsertNextValue(run.Held);
     fd->AddArray(local);
-    vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", haloRadius);
+    vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", run.Radius);
     vtkNew<vtkIdTypeArray> rounds;
     rounds->SetName("HaloAttempts");
-    rounds->InsertNextValue(attempts);
+    rounds->InsertNextValue(run.Attempts);
     fd->AddArray(rounds);
   }
   return 1;
