@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Common/Distribution.h"
 
-#include "Common/Statistics.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -66,12 +64,8 @@ double FromOrderedBits(std::uint64_t key)
 
 double GlobalMedian(const Distribution* d, std::vector<double> values)
 {
-  if (!d)
-  {
-    return Median(std::move(values));
-  }
   const Index total = GlobalSum(d, static_cast<Index>(values.size()));
-  return GlobalSelect(d, std::move(values), total / 2); // Median's upper median
+  return GlobalSelect(d, std::move(values), total / 2); // Median's upper median (0 when there are none)
 }
 
 void GlobalBounds(const Distribution* d, const double* xyz, Index n, double bounds[6])
@@ -200,6 +194,37 @@ void UpdateHaloRows(const Distribution* d, std::vector<std::int32_t>& rows, int 
       const auto found = key >= 0.0 ? local.find(static_cast<std::int64_t>(key)) : local.end();
       rows[static_cast<size_t>(i) * width + j] = found != local.end() ? found->second : -1;
     }
+  }
+}
+
+void UpdateHaloInOrder(const Distribution* d, const std::vector<Index>& order, Index n,
+  std::initializer_list<std::vector<double>*> sorted)
+{
+  if (!d)
+  {
+    return;
+  }
+  const int components = static_cast<int>(sorted.size());
+  const size_t nv = order.size();
+  std::vector<double> perPoint(static_cast<size_t>(n) * components, 0.0);
+  int c = 0;
+  for (const std::vector<double>* values : sorted)
+  {
+    for (size_t s = 0; s < nv; ++s)
+    {
+      perPoint[static_cast<size_t>(order[s]) * components + c] = (*values)[s];
+    }
+    ++c;
+  }
+  d->UpdateHalo(perPoint.data(), components);
+  c = 0;
+  for (std::vector<double>* values : sorted)
+  {
+    for (size_t s = 0; s < nv; ++s)
+    {
+      (*values)[s] = perPoint[static_cast<size_t>(order[s]) * components + c];
+    }
+    ++c;
   }
 }
 

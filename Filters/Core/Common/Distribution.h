@@ -17,6 +17,7 @@
 #define meshfree_Distribution_h
 
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 namespace meshfree
@@ -44,6 +45,12 @@ public:
   virtual double Complete(const double x[3]) const = 0;
 };
 
+/// Whether local point i is this process' own (every point when serial).
+inline bool IsOwn(const Distribution* d, Index i)
+{
+  return !d || d->Owned(i);
+}
+
 /// How far a query of radius `reach` around x exceeds what the local cloud holds (<= 0: it found every point
 /// the whole cloud has there); -infinity when serial. A computation reports the largest: a halo that is wider
 /// by that much gives the same result as the serial run.
@@ -68,10 +75,14 @@ void UpdateHalo(const Distribution* d, std::vector<unsigned char>& values);
 /// Rows of `width` local point indices per point (-1 pads, as neighbour graphs store them): the halo points' rows
 /// replaced by their owners', translated through Key() (an entry whose point is not in the local cloud: -1).
 void UpdateHaloRows(const Distribution* d, std::vector<std::int32_t>& rows, int width);
+/// UpdateHalo for values kept in a grid's sorted order (one per sorted position s, of local point order[s]):
+/// each vector of `sorted` is one component; n is the number of local points.
+void UpdateHaloInOrder(const Distribution* d, const std::vector<Index>& order, Index n,
+  std::initializer_list<std::vector<double>*> sorted);
 
 /// A sample of a cloud's points that does not depend on their order nor on how they are split among the
-/// processes: the `count` points (of the whole cloud) with the smallest hash of their coordinates' bits. The
-/// local cloud's candidates are given by `positions` (e.g. a grid's sorted points) with `eligible(i)`.
+/// processes: the `count` points (of the whole cloud) with the smallest hash of their coordinates' bits, among
+/// each process' candidates (Choose: its points xyz, e.g. a grid's sorted points, with eligible(i)).
 class CloudSample
 {
 public:

@@ -285,15 +285,16 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   {
     return false;
   }
-  for (int a = 0; a < 3; ++a)
+  // The cells' box: the frame's when one is set (its bounds were copied above), else the valid points' own.
+  for (int a = 0; a < 3 && !this->Framed; ++a)
   {
-    this->Origin[a] = this->Framed ? this->FrameBounds[2 * a] : lo[a];
-    this->Extent[a] = this->Framed ? this->FrameBounds[2 * a + 1] - this->FrameBounds[2 * a] : hi[a] - lo[a];
+    this->FrameUsedBounds[2 * a] = lo[a];
+    this->FrameUsedBounds[2 * a + 1] = hi[a];
   }
   for (int a = 0; a < 3; ++a)
   {
-    this->FrameUsedBounds[2 * a] = this->Framed ? this->FrameBounds[2 * a] : lo[a];
-    this->FrameUsedBounds[2 * a + 1] = this->Framed ? this->FrameBounds[2 * a + 1] : hi[a];
+    this->Origin[a] = this->FrameUsedBounds[2 * a];
+    this->Extent[a] = this->FrameUsedBounds[2 * a + 1] - this->FrameUsedBounds[2 * a];
   }
   this->FrameUsedPoints = this->Framed ? this->FramePoints : m;
   this->ChooseGrid(cellSize, this->FrameUsedPoints);

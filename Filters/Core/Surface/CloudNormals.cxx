@@ -195,18 +195,7 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
     if (d)
     {
       // The halo's values of this round from their owners (they average over neighbours beyond the halo).
-      std::vector<double>& perPoint = next; // free until the next round
-      perPoint.assign(static_cast<size_t>(n), 0.0);
-      for (Index s = 0; s < nv; ++s)
-      {
-        perPoint[order[s]] = k[s];
-      }
-      d->UpdateHalo(perPoint.data(), 1);
-      for (Index s = 0; s < nv; ++s)
-      {
-        k[s] = perPoint[order[s]];
-      }
-      next.assign(static_cast<size_t>(nv), 0.0);
+      UpdateHaloInOrder(d, order, n, { &k });
     }
   }
   curvature.assign(static_cast<size_t>(n), 0.0);
@@ -236,18 +225,7 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
   {
     if (!merged)
     {
-      unique = UniqueCloud();
-      unique.Points.assign(xyz, xyz + 3 * std::max<Index>(n, 0));
-      if (referenceNormals)
-      {
-        unique.Normals.assign(referenceNormals, referenceNormals + 3 * std::max<Index>(n, 0));
-      }
-      unique.Unique.resize(static_cast<size_t>(std::max<Index>(n, 0)));
-      for (Index i = 0; i < n; ++i)
-      {
-        const double* x = xyz + 3 * i;
-        unique.Unique[i] = std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]) ? i : -1;
-      }
+      MergeDuplicates(grid, xyz, referenceNormals, unique, true); // this process has none: its points as they are
     }
     // Computed on the distinct points, in the same frame; every duplicate gets its representative's results.
     CloudNormalsOptions distinctOptions = options;
@@ -269,7 +247,7 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
       result.Invalid = 0;
       for (Index i = 0; i < n; ++i)
       {
-        result.Invalid += d->Owned(i) && !result.Valid[i] ? 1 : 0;
+        result.Invalid += IsOwn(d, i) && !result.Valid[i] ? 1 : 0;
       }
     }
     return done;
@@ -341,7 +319,7 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
     // A projection moves a point at most one support and queries one support around it there.
     for (Index i = 0; d && i < n; ++i)
     {
-      if (field.Valid[i] && d->Owned(i))
+      if (field.Valid[i] && IsOwn(d, i))
       {
         result.Shortfall = std::max(result.Shortfall, Shortfall(d, xyz + 3 * i, 2.0 * 3.0 * median));
       }
@@ -364,7 +342,7 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
         for (Index s = begin + b0; s < begin + b1; ++s)
         {
           const Index i = order[s];
-          if (!field.Valid[i] || (d && !d->Owned(i)))
+          if (!field.Valid[i] || !IsOwn(d, i))
           {
             continue;
           }

@@ -67,6 +67,18 @@ struct Node
   std::int64_t Component = 0;
   bool operator<(const Node& o) const { return std::tie(this->Block, this->Component) < std::tie(o.Block, o.Component); }
   bool operator==(const Node& o) const { return this->Block == o.Block && this->Component == o.Component; }
+  /// As three doubles (exact: the key's two 32-bit halves and the component), for the processes' exchanges.
+  void Write(double* out) const
+  {
+    out[0] = static_cast<double>(this->Block >> 32);
+    out[1] = static_cast<double>(this->Block & 0xffffffffull);
+    out[2] = static_cast<double>(this->Component);
+  }
+  static Node Read(const double* in)
+  {
+    return Node{ (static_cast<std::uint64_t>(in[0]) << 32) | static_cast<std::uint64_t>(in[1]),
+      static_cast<std::int64_t>(in[2]) };
+  }
 };
 
 /// Blocks: cubes of edge `edge` anchored at the frame's minimum (the whole cloud's, NeighborGrid::SetFrame), keyed
@@ -164,24 +176,19 @@ void ReduceNodes(const Distribution* d, const std::vector<Node>& localNodes,
     sums = localSums;
     return;
   }
-  std::vector<double> mine, all;
+  std::vector<double> mine(11 * localNodes.size()), all;
   for (size_t m = 0; m < localNodes.size(); ++m)
   {
-    mine.insert(mine.end(), { static_cast<double>(localNodes[m].Block >> 32),
-                              static_cast<double>(localNodes[m].Block & 0xffffffffull),
-                              static_cast<double>(localNodes[m].Component) });
-    mine.insert(mine.end(), localSums[m].begin(), localSums[m].end());
+    localNodes[m].Write(&mine[11 * m]);
+    std::copy(localSums[m].begin(), localSums[m].end(), &mine[11 * m + 3]);
   }
   d->Gather(mine, all);
   std::vector<std::pair<Node, std::array<double, 8>>> entries;
   for (size_t e = 0; e + 11 <= all.size(); e += 11)
   {
-    const double* v = &all[e];
     std::array<double, 8> values;
-    std::copy(v + 3, v + 11, values.begin());
-    entries.push_back({ Node{ (static_cast<std::uint64_t>(v[0]) << 32) | static_cast<std::uint64_t>(v[1]),
-                          static_cast<std::int64_t>(v[2]) },
-      values });
+    std::copy(&all[e + 3], &all[e + 11], values.begin());
+    entries.push_back({ Node::Read(&all[e]), values });
   }
   std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   nodes.clear();
@@ -230,34 +237,25 @@ void SumVotes(std::vector<std::tuple<Node, Node, std::int64_t>>& votes,
 void ReduceVotes(const Distribution* d, std::vector<std::tuple<Node, Node, std::int64_t>>& votes,
   std::vector<std::tuple<Node, Node, std::int64_t>>& links)
 {
-  auto reduce = [&]() { SumVotes(votes, links, false); };
-  reduce();
+  SumVotes(votes, links, false);
   if (!d)
   {
     return;
   }
-  std::vector<double> mine, all;
-  for (const auto& l : links)
+  std::vector<double> mine(7 * links.size()), all;
+  for (size_t l = 0; l < links.size(); ++l)
   {
-    const Node& a = std::get<0>(l);
-    const Node& b = std::get<1>(l);
-    mine.insert(mine.end(),
-      { static_cast<double>(a.Block >> 32), static_cast<double>(a.Block & 0xffffffffull),
-        static_cast<double>(a.Component), static_cast<double>(b.Block >> 32),
-        static_cast<double>(b.Block & 0xffffffffull), static_cast<double>(b.Component),
-        static_cast<double>(std::get<2>(l)) });
+    std::get<0>(links[l]).Write(&mine[7 * l]);
+    std::get<1>(links[l]).Write(&mine[7 * l + 3]);
+    mine[7 * l + 6] = static_cast<double>(std::get<2>(links[l]));
   }
   d->Gather(mine, all);
   votes.clear();
-  auto node = [](const double* v) {
-    return Node{ (static_cast<std::uint64_t>(v[0]) << 32) | static_cast<std::uint64_t>(v[1]),
-      static_cast<std::int64_t>(v[2]) };
-  };
   for (size_t e = 0; e + 7 <= all.size(); e += 7)
   {
-    votes.emplace_back(node(&all[e]), node(&all[e + 3]), static_cast<std::int64_t>(all[e + 6]));
+    votes.emplace_back(Node::Read(&all[e]), Node::Read(&all[e + 3]), static_cast<std::int64_t>(all[e + 6]));
   }
-  reduce();
+  SumVotes(votes, links, false);
 }
 } // namespace
 
@@ -268,7 +266,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   const Index n = static_cast<Index>(field.Valid.size());
   confidence.assign(static_cast<size_t>(n), 0.0);
   const Distribution* d = options.Processes;
-  auto own = [d](Index i) { return !d || d->Owned(i); };
+
 
   if (options.Mode == OrientationMode::Reference && options.Reference)
   {
@@ -289,7 +287,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
         m[2] = -m[2];
       }
       confidence[i] = std::fabs(c);
-      report.Ambiguous += confidence[i] < 0.5 && own(i) ? 1 : 0;
+      report.Ambiguous += confidence[i] < 0.5 && IsOwn(d, i) ? 1 : 0;
     }
     report.Ambiguous = GlobalSum(d, report.Ambiguous);
     return report;
@@ -309,7 +307,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     rank[id] = static_cast<std::int32_t>(s);
     std::copy(&field.Normals[3 * id], &field.Normals[3 * id] + 3, &normals[3 * s]);
     valid[s] = field.Valid[id] && !field.Outlier[id];
-    if (valid[s] && own(id))
+    if (valid[s] && IsOwn(d, id))
     {
       distances.push_back(field.NeighborDistance[id]);
     }
@@ -338,7 +336,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     if (valid[s])
     {
       blockOf[s] = blocks.Key(xyz + 3 * s);
-      if (own(order[s]))
+      if (IsOwn(d, order[s]))
       {
         wanted.push_back(blockOf[s]);
         // The whole block lies within its diagonal of the point.
@@ -481,8 +479,8 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     nodeBegin[b + 1] = nodeBegin[b] + static_cast<size_t>(blockComponents[b]);
   }
 
-  // Per point: whether the propagation turned it and its node (block, component). Serially from the blocks'
-  // arrays; distributed, in `state` (the halo's from their owners).
+  // Per point: whether the propagation turned it (-1 or 1; 0: no node) and its node (block, component). Serially
+  // from the blocks' arrays; distributed, in `state` (the halo's from their owners).
   std::vector<double> state(d ? static_cast<size_t>(4 * n) : 0, 0.0);
   auto turnedInBlock = [&](Index s) { return Dot(&normals[3 * s], &field.Normals[3 * order[s]]) < 0.0; };
   ParallelFor(d ? nv : 0, 4096, [&](Index b0, Index b1) {
@@ -492,22 +490,14 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       {
         double* st = &state[4 * order[s]];
         st[0] = turnedInBlock(s) ? -1.0 : 1.0;
-        st[1] = static_cast<double>(blockOf[s] >> 32);
-        st[2] = static_cast<double>(blockOf[s] & 0xffffffffull);
-        st[3] = static_cast<double>(component[s] + 1); // 0: none
+        Node{ blockOf[s], component[s] }.Write(st + 1);
       }
     }
   });
   UpdateHalo(d, state, 4);
-  auto hasNode = [&](Index id) { return d ? state[4 * id + 3] >= 1.0 : rank[id] >= 0 && component[rank[id]] >= 0; };
+  auto hasNode = [&](Index id) { return d ? state[4 * id] != 0.0 : rank[id] >= 0 && component[rank[id]] >= 0; };
   auto nodeOf = [&](Index id) {
-    if (!d)
-    {
-      return Node{ blockOf[rank[id]], component[rank[id]] };
-    }
-    const double* st = &state[4 * id];
-    return Node{ (static_cast<std::uint64_t>(st[1]) << 32) | static_cast<std::uint64_t>(st[2]),
-      static_cast<std::int64_t>(st[3]) - 1 };
+    return d ? Node::Read(&state[4 * id + 1]) : Node{ blockOf[rank[id]], component[rank[id]] };
   };
   auto signOf = [&](Index id) { return d ? state[4 * id] : (turnedInBlock(rank[id]) ? -1.0 : 1.0); };
 
@@ -535,7 +525,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       {
         const std::int32_t s = members[m].second;
         const Index id = order[s];
-        if (!own(id))
+        if (!IsOwn(d, id))
         {
           continue;
         }
@@ -665,7 +655,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   Index ambiguous = 0;
   for (Index i = 0; i < n; ++i)
   {
-    if (!field.Valid[i] || !own(i))
+    if (!field.Valid[i] || !IsOwn(d, i))
     {
       continue;
     }

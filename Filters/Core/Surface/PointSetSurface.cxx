@@ -11,7 +11,6 @@ namespace meshfree
 
 void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, const double* radii, const Distribution* d)
 {
-  auto own = [d](Index id) { return !d || d->Owned(id); };
   this->Grid = &grid;
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
@@ -43,7 +42,7 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
   supports.reserve(static_cast<size_t>(nv));
   for (Index s = 0; s < nv; ++s)
   {
-    if (std::isfinite(this->InverseRadii[s]) && own(order[s]))
+    if (std::isfinite(this->InverseRadii[s]) && IsOwn(d, order[s]))
     {
       supports.push_back(1.0 / this->InverseRadii[s]);
     }
@@ -111,7 +110,7 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     ownCoordinates.clear();
     for (size_t w = 0; w < positions[t].size(); ++w)
     {
-      if (own(order[positions[t][w]]))
+      if (IsOwn(d, order[positions[t][w]]))
       {
         ownCoordinates.insert(ownCoordinates.end(), &coordinates[t][3 * w], &coordinates[t][3 * w] + 3);
       }

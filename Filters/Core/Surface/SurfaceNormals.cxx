@@ -546,7 +546,7 @@ void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vect
     {
       const Index id = order[s];
       const double radius = field.Radii[id];
-      if (!field.Valid[id] || !flagged(s) || (d && !d->Owned(id)))
+      if (!field.Valid[id] || !flagged(s) || !IsOwn(d, id))
       {
         continue;
       }
@@ -623,10 +623,9 @@ void FlagOutliers(NormalField& field, const Distribution* d)
 {
   std::vector<double> residuals, distances;
   const size_t n = field.Valid.size();
-  auto own = [d](size_t i) { return !d || d->Owned(static_cast<Index>(i)); };
   for (size_t i = 0; i < n; ++i)
   {
-    if (field.Valid[i] && own(i))
+    if (field.Valid[i] && IsOwn(d, static_cast<Index>(i)))
     {
       residuals.push_back(field.Residual[i]);
       distances.push_back(field.NeighborDistance[i]);
@@ -637,7 +636,7 @@ void FlagOutliers(NormalField& field, const Distribution* d)
   const int k = field.GraphDegree;
   for (size_t i = 0; i < n; ++i)
   {
-    if (!field.Valid[i] || !own(i))
+    if (!field.Valid[i] || !IsOwn(d, static_cast<Index>(i)))
     {
       continue;
     }
@@ -680,20 +679,19 @@ void ShareEstimates(const Distribution* d, const NeighborGrid& grid, NormalField
   }
   UpdateHalo(d, field.Valid);
   UpdateHaloRows(d, field.Graph, field.GraphDegree);
-  const std::vector<Index>& order = grid.SortedOrder();
-  const Index nv = static_cast<Index>(order.size());
-  std::vector<double> perPoint(2 * field.Valid.size(), 0.0);
-  for (Index s = 0; s < nv; ++s)
+  UpdateHaloInOrder(d, grid.SortedOrder(), static_cast<Index>(field.Valid.size()), { &rms, &height });
+}
+
+/// The largest Shortfall of this process' sample queries, at local sample point j of radius(j).
+template <class Radius>
+double SampleShortfall(const Distribution* d, const CloudSample& sample, const double* sorted, const Radius& radius)
+{
+  double shortfall = -HUGE_VAL;
+  for (size_t j = 0; d && j < sample.Local().size(); ++j)
   {
-    perPoint[2 * order[s]] = rms[s];
-    perPoint[2 * order[s] + 1] = height[s];
+    shortfall = std::max(shortfall, Shortfall(d, sorted + 3 * sample.Local()[j], radius(j)));
   }
-  UpdateHalo(d, perPoint, 2);
-  for (Index s = 0; s < nv; ++s)
-  {
-    rms[s] = perPoint[2 * order[s]];
-    height[s] = perPoint[2 * order[s] + 1];
-  }
+  return shortfall;
 }
 
 /// The radius that keeps the noise's tilt below tau: R^2 = 2 sigma h / (sqrt(pi) tau).
@@ -738,10 +736,8 @@ void EstimateNormalRadius(
         localCurvature[j] = fit.Valid ? fit.Curvature : 0.0;
       }
     });
-    for (Index j = 0; j < mineCount; ++j)
-    {
-      scale.SampleShortfall = std::max(scale.SampleShortfall, Shortfall(d, sorted + 3 * sample.Local()[j], radius));
-    }
+    scale.SampleShortfall =
+      std::max(scale.SampleShortfall, SampleShortfall(d, sample, sorted, [radius](size_t) { return radius; }));
     rms = sample.Gather(d, localRms);
     curvature = sample.Gather(d, localCurvature);
     // The misfit also grows where a neighbourhood takes in two sheets (a part thinner than it): the noise is
@@ -800,7 +796,7 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
   const double* sorted = grid.SortedPoints();
   // The sample: the same points whatever the input's order and split among processes (CloudSample).
   CloudSample sample;
-  sample.Choose(d, sorted, nv, SamplePoints, [&](Index s) { return !d || d->Owned(order[s]); });
+  sample.Choose(d, sorted, nv, SamplePoints, [&](Index s) { return IsOwn(d, order[s]); });
   if (sample.Size() < 3)
   {
     return scale;
@@ -835,10 +831,7 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
       spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
     }
   });
-  for (Index j = 0; j < samples; ++j)
-  {
-    scale.SampleShortfall = std::max(scale.SampleShortfall, Shortfall(d, sorted + 3 * sample.Local()[j], kth[j]));
-  }
+  scale.SampleShortfall = SampleShortfall(d, sample, sorted, [&kth](size_t j) { return kth[j]; });
   const double rk = Median(sample.Gather(d, kth));
   scale.Spacing = rk * std::sqrt(Pi / k);
   scale.Noise = Median(sample.Gather(d, spread));
@@ -861,10 +854,8 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
         spread[j] = pca.Valid ? std::sqrt(pca.Eigenvalues[0]) : 0.0;
       }
     });
-    for (Index j = 0; j < samples; ++j)
-    {
-      scale.SampleShortfall = std::max(scale.SampleShortfall, Shortfall(d, sorted + 3 * sample.Local()[j], radius));
-    }
+    scale.SampleShortfall =
+      std::max(scale.SampleShortfall, SampleShortfall(d, sample, sorted, [radius](size_t) { return radius; }));
     scale.Noise = Median(sample.Gather(d, spread));
     const double next = std::max(rk, NoiseRadius(scale.Noise, scale.Spacing, options.TiltTolerance));
     const bool settled = std::fabs(next - radius) < 0.05 * radius;
@@ -968,7 +959,7 @@ bool EstimateNormals(
         for (Index s = begin + b0; s < begin + b1; ++s)
         {
           const Index id = order[s];
-          if (d && !d->Owned(id))
+          if (!IsOwn(d, id))
           {
             continue; // a halo point: its owner estimates it
           }
@@ -1145,7 +1136,7 @@ std::vector<double> FitSupports(const NormalField& field, double supportScale, d
   positive.reserve(n);
   for (size_t i = 0; i < n; ++i)
   {
-    if (support[i] > 0.0 && (!d || d->Owned(static_cast<Index>(i))))
+    if (support[i] > 0.0 && IsOwn(d, static_cast<Index>(i)))
     {
       positive.push_back(support[i]);
     }

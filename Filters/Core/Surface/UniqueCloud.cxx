@@ -4,11 +4,12 @@
 namespace meshfree
 {
 
-bool MergeDuplicates(const NeighborGrid& grid, const double* xyz, const double* normals, UniqueCloud& unique)
+bool MergeDuplicates(
+  const NeighborGrid& grid, const double* xyz, const double* normals, UniqueCloud& unique, bool always)
 {
   std::vector<Index> representative;
   const Index duplicates = grid.FindDuplicates(representative);
-  if (duplicates == 0)
+  if (duplicates == 0 && !always)
   {
     return false;
   }

@@ -22,8 +22,10 @@ struct UniqueCloud
 };
 
 /// Fills `unique` from the points the grid was built over (xyz, and normals or null) when they hold exact
-/// duplicates; returns false (unique untouched) when there are none.
-bool MergeDuplicates(const NeighborGrid& grid, const double* xyz, const double* normals, UniqueCloud& unique);
+/// duplicates, or always with `always` (then without duplicates it is the valid points themselves); returns
+/// whether it filled it (unique untouched otherwise).
+bool MergeDuplicates(
+  const NeighborGrid& grid, const double* xyz, const double* normals, UniqueCloud& unique, bool always = false);
 
 } // namespace meshfree
 
