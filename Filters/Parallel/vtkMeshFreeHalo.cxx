@@ -15,6 +15,7 @@
 #include "vtkUnsignedCharArray.h"
 
 #include "Common/NeighborGrid.h"
+#include "Common/Statistics.h"
 
 #include <algorithm>
 #include <cmath>
@@ -661,4 +662,26 @@ void vtkMeshFreeHalo::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfGlobalPoints: " << this->NumberOfGlobalPoints << "\n";
   os << indent << "Radius: " << this->Radius << "\n";
   os << indent << "NumberOfRounds: " << this->NumberOfRounds << "\n";
+}
+
+double vtkMeshFreeHalo::LocalNeighborDistance(const double* xyz, vtkIdType n, int k)
+{
+  meshfree::NeighborGrid grid;
+  grid.Build(xyz, n);
+  const meshfree::Index nv = grid.NumberOfValidPoints();
+  if (nv <= k)
+  {
+    return 0.0;
+  }
+  std::vector<meshfree::Index> ids;
+  std::vector<double> dist2, kth;
+  const meshfree::Index samples = std::min<meshfree::Index>(nv, 256);
+  for (meshfree::Index j = 0; j < samples; ++j)
+  {
+    if (grid.FindKNearest(grid.SortedPoints() + 3 * (j * nv / samples), k + 1, ids, dist2) == k + 1)
+    {
+      kth.push_back(std::sqrt(dist2.back()));
+    }
+  }
+  return meshfree::Median(std::move(kth));
 }

@@ -137,6 +137,10 @@ public:
   /// Bounds of the finite positions among n interleaved x, y, z (an empty box, min > max, when none is).
   static void FiniteBounds(const double* xyz, vtkIdType n, double bounds[6]);
 
+  /// The median distance from up to 256 of the n points to their k-th nearest among them (a rank's own points: an
+  /// upper bound of the whole cloud's); 0 when there are too few. A halo's first radius is a multiple of it.
+  static double LocalNeighborDistance(const double* xyz, vtkIdType n, int k);
+
 protected:
   vtkMeshFreeHalo();
   ~vtkMeshFreeHalo() override;

@@ -30,6 +30,20 @@ vtkMeshFreeHaloDistribution::vtkMeshFreeHaloDistribution(
   }
 }
 
+vtkMeshFreeHaloDistribution::vtkMeshFreeHaloDistribution(vtkMultiProcessController* controller, vtkIdType n)
+  : Controller(controller)
+  , Halo(nullptr)
+  , NumberOfOwned(n)
+  , Radius(0.0)
+  , Ids(static_cast<size_t>(n))
+{
+  std::fill(this->Region, this->Region + 6, 0.0);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    this->Ids[i] = i;
+  }
+}
+
 double vtkMeshFreeHaloDistribution::Complete(const double x[3]) const
 {
   double depth = HUGE_VAL;
@@ -66,8 +80,40 @@ void vtkMeshFreeHaloDistribution::Gather(const std::vector<double>& mine, std::v
 
 void vtkMeshFreeHaloDistribution::UpdateHalo(double* values, int components) const
 {
+  if (!this->Halo)
+  {
+    return;
+  }
   vtkNew<vtkDoubleArray> array;
   array->SetNumberOfComponents(components);
   array->SetArray(values, static_cast<vtkIdType>(this->Ids.size()) * components, 1); // 1: not freed by the array
   this->Halo->UpdateHalo(array);
+}
+
+int vtkMeshFreeHaloDistribution::Rank() const
+{
+  return this->Controller ? this->Controller->GetLocalProcessId() : 0;
+}
+
+int vtkMeshFreeHaloDistribution::Size() const
+{
+  return this->Controller ? this->Controller->GetNumberOfProcesses() : 1;
+}
+
+void vtkMeshFreeHaloDistribution::SetSlab(int axis, double lower, double upper)
+{
+  this->SlabAxis = axis;
+  this->SlabLower = lower;
+  this->SlabUpper = upper;
+}
+
+bool vtkMeshFreeHaloDistribution::OwnsPosition(const double x[3]) const
+{
+  return this->SlabAxis < 0 || (this->SlabLower <= x[this->SlabAxis] && x[this->SlabAxis] < this->SlabUpper);
+}
+
+bool vtkMeshFreeHaloDistribution::OwnsBall(const double x[3], double radius) const
+{
+  return this->SlabAxis < 0 ||
+    (this->SlabLower <= x[this->SlabAxis] - radius && x[this->SlabAxis] + radius < this->SlabUpper);
 }

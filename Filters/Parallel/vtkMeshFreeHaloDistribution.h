@@ -28,7 +28,11 @@ public:
   /// The halo must have exchanged (Exchange, with `region` and `radius`) before; it must outlive this object.
   vtkMeshFreeHaloDistribution(
     vtkMultiProcessController* controller, vtkMeshFreeHalo* halo, const double region[6], double radius);
+  /// Without a halo: n points, all this rank's own (keys: their indices); for reductions and selections only.
+  vtkMeshFreeHaloDistribution(vtkMultiProcessController* controller, vtkIdType n);
 
+  int Rank() const override;
+  int Size() const override;
   bool Owned(meshfree::Index i) const override { return i < this->NumberOfOwned; }
   std::int64_t Key(meshfree::Index i) const override { return this->Ids[static_cast<size_t>(i)]; }
   void Sum(double* values, meshfree::Index count) const override;
@@ -39,6 +43,12 @@ public:
   /// The radius plus x's distance to the border of the region (0 outside it).
   double Complete(const double x[3]) const override;
 
+  /// Space partitioned in slabs along `axis` (vtkMeshFreeSlabs): this rank owns the positions with lower <=
+  /// x[axis] < upper. Without it, this rank owns every position (OwnsPosition, OwnsBall).
+  void SetSlab(int axis, double lower, double upper);
+  bool OwnsPosition(const double x[3]) const override;
+  bool OwnsBall(const double x[3], double radius) const override;
+
 private:
   vtkMultiProcessController* Controller;
   vtkMeshFreeHalo* Halo;
@@ -46,6 +56,9 @@ private:
   double Region[6];
   double Radius;
   std::vector<std::int64_t> Ids;
+  int SlabAxis = -1;
+  double SlabLower = 0.0;
+  double SlabUpper = 0.0;
 };
 
 #endif

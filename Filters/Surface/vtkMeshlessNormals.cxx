@@ -72,29 +72,6 @@ struct HaloRun
 /// The halo's first radius: this many times the distance to the k-th nearest point (below).
 constexpr double HaloNeighborhoods = 8.0;
 
-/// The median distance from up to 256 of the n points to their k-th nearest among them (a rank's own points:
-/// an upper bound of the whole cloud's); 0 when there are too few.
-double LocalNeighborDistance(const double* xyz, vtkIdType n, int k)
-{
-  meshfree::NeighborGrid grid;
-  grid.Build(xyz, n);
-  const meshfree::Index nv = grid.NumberOfValidPoints();
-  if (nv <= k)
-  {
-    return 0.0;
-  }
-  std::vector<meshfree::Index> ids;
-  std::vector<double> dist2, kth;
-  const meshfree::Index samples = std::min<meshfree::Index>(nv, 256);
-  for (meshfree::Index j = 0; j < samples; ++j)
-  {
-    if (grid.FindKNearest(grid.SortedPoints() + 3 * (j * nv / samples), k + 1, ids, dist2) == k + 1)
-    {
-      kth.push_back(std::sqrt(dist2.back()));
-    }
-  }
-  return meshfree::Median(std::move(kth));
-}
 /// Distributed (collective): this rank's points with a halo from the others (vtkMeshFreeHalo), the core computing
 /// its own points' results (their first `input` points), with the same bits as a serial run. referenceNormals
 /// (reference orientation) is given or not on every rank alike (an empty rank passes an empty array).
@@ -142,7 +119,7 @@ bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* con
   // The halo: first as wide as a few neighbourhoods, then as wide as the computation reports it reached (its
   // Shortfall; the last attempt takes every point, which is always enough).
   const int k = std::max(3, options.Neighborhood.NeighborCount);
-  double radius = HaloNeighborhoods * vtkMeshFreeHalo::GlobalMax(controller, LocalNeighborDistance(xyz, n, k));
+  double radius = HaloNeighborhoods * vtkMeshFreeHalo::GlobalMax(controller, vtkMeshFreeHalo::LocalNeighborDistance(xyz, n, k));
   if (options.Neighborhood.SupportRadius > 0.0)
   {
     radius = std::max(radius, 2.0 * options.Neighborhood.SupportRadius);

@@ -7,6 +7,7 @@
 #include "Common/Parallel.h"
 #include "Surface/CloudNormals.h"
 #include "SurfaceSamples.h"
+#include "ThreadProcesses.h"
 
 #include <gtest/gtest.h>
 
@@ -20,149 +21,11 @@
 #include <vector>
 
 using namespace meshfree;
+using namespace meshfree::testing;
 namespace samples = meshfree::testing;
 
 namespace
 {
-/// A reusable barrier for P threads.
-class Barrier
-{
-public:
-  explicit Barrier(int count)
-    : Count(count)
-  {
-  }
-  void Wait()
-  {
-    std::unique_lock<std::mutex> lock(this->Mutex);
-    const long generation = this->Generation;
-    if (++this->Arrived == this->Count)
-    {
-      this->Arrived = 0;
-      ++this->Generation;
-      this->Ready.notify_all();
-      return;
-    }
-    this->Ready.wait(lock, [&] { return generation != this->Generation; });
-  }
-
-private:
-  std::mutex Mutex;
-  std::condition_variable Ready;
-  int Count;
-  int Arrived = 0;
-  long Generation = 0;
-};
-
-/// What the "processes" share: one slot per process for each collective step.
-struct World
-{
-  explicit World(int size)
-    : Size(size)
-    , Sync(size)
-    , Slots(size)
-    , Pointers(size, nullptr)
-  {
-  }
-  int Size;
-  Barrier Sync;
-  std::vector<std::vector<double>> Slots;
-  std::vector<double*> Pointers;
-};
-
-/// A piece: its points (own first, then the halo), per point its owner and the owner's local index, its region.
-struct Piece
-{
-  std::vector<double> Points;
-  std::vector<int> Owner;
-  std::vector<Index> OwnerIndex;
-  std::vector<std::int64_t> Keys;
-  Index OwnCount = 0;
-  double Region[6];
-  double Radius = 0.0;
-};
-
-class ThreadDistribution : public Distribution
-{
-public:
-  ThreadDistribution(World& world, int rank, const std::vector<Piece>& pieces)
-    : W(world)
-    , Rank(rank)
-    , Pieces(pieces)
-  {
-  }
-  bool Owned(Index i) const override { return i < this->Pieces[this->Rank].OwnCount; }
-  std::int64_t Key(Index i) const override { return this->Pieces[this->Rank].Keys[i]; }
-  void Sum(double* values, Index count) const override
-  {
-    this->Reduce(values, count, [](double a, double b) { return a + b; });
-  }
-  void Sum(std::int64_t* values, Index count) const override
-  {
-    std::vector<double> wide(values, values + count);
-    this->Reduce(wide.data(), count, [](double a, double b) { return a + b; });
-    std::transform(wide.begin(), wide.end(), values, [](double v) { return static_cast<std::int64_t>(v); });
-  }
-  void Max(double* values, Index count) const override
-  {
-    this->Reduce(values, count, [](double a, double b) { return std::max(a, b); });
-  }
-  void Gather(const std::vector<double>& mine, std::vector<double>& all) const override
-  {
-    this->W.Slots[this->Rank] = mine;
-    this->W.Sync.Wait();
-    all.clear();
-    for (const std::vector<double>& slot : this->W.Slots)
-    {
-      all.insert(all.end(), slot.begin(), slot.end());
-    }
-    this->W.Sync.Wait();
-  }
-  void UpdateHalo(double* values, int components) const override
-  {
-    this->W.Pointers[this->Rank] = values;
-    this->W.Sync.Wait();
-    const Piece& p = this->Pieces[this->Rank];
-    for (size_t i = static_cast<size_t>(p.OwnCount); i < p.Points.size() / 3; ++i)
-    {
-      const double* from = this->W.Pointers[p.Owner[i]] + p.OwnerIndex[i] * components;
-      std::copy(from, from + components, values + i * components);
-    }
-    this->W.Sync.Wait();
-  }
-  double Complete(const double x[3]) const override
-  {
-    const Piece& p = this->Pieces[this->Rank];
-    double depth = HUGE_VAL;
-    for (int a = 0; a < 3; ++a)
-    {
-      depth = std::min(depth, std::min(x[a] - p.Region[2 * a], p.Region[2 * a + 1] - x[a]));
-    }
-    return p.Radius + std::max(depth, 0.0);
-  }
-
-private:
-  template <class Op>
-  void Reduce(double* values, Index count, Op op) const
-  {
-    this->W.Slots[this->Rank].assign(values, values + count);
-    this->W.Sync.Wait();
-    for (Index j = 0; j < count; ++j)
-    {
-      double v = this->W.Slots[0][j];
-      for (int r = 1; r < this->W.Size; ++r)
-      {
-        v = op(v, this->W.Slots[r][j]);
-      }
-      values[j] = v;
-    }
-    this->W.Sync.Wait();
-  }
-  World& W;
-  int Rank;
-  const std::vector<Piece>& Pieces;
-};
-
 /// Splits the cloud into `size` slabs along x (owner by position rank), each with every point within `radius`
 /// of its slab's box as halo. Keys are the input indices.
 std::vector<Piece> Split(const std::vector<double>& xyz, int size, double radius)

@@ -29,6 +29,28 @@ Index GlobalSum(const Distribution* d, Index value)
   return static_cast<Index>(v);
 }
 
+std::vector<std::uint64_t> GatherKeys(const Distribution* d, const std::vector<std::uint64_t>& mine)
+{
+  if (!d)
+  {
+    return mine;
+  }
+  // Two exact 32-bit halves per key (a double holds integers up to 2^53).
+  std::vector<double> halves(2 * mine.size()), all;
+  for (size_t i = 0; i < mine.size(); ++i)
+  {
+    halves[2 * i] = static_cast<double>(mine[i] >> 32);
+    halves[2 * i + 1] = static_cast<double>(mine[i] & 0xffffffffu);
+  }
+  d->Gather(halves, all);
+  std::vector<std::uint64_t> keys(all.size() / 2);
+  for (size_t i = 0; i < keys.size(); ++i)
+  {
+    keys[i] = (static_cast<std::uint64_t>(all[2 * i]) << 32) | static_cast<std::uint64_t>(all[2 * i + 1]);
+  }
+  return keys;
+}
+
 double Shortfall(const Distribution* d, const double x[3], double reach)
 {
   return d ? reach - d->Complete(x) : -HUGE_VAL;

@@ -28,6 +28,9 @@ class Distribution
 {
 public:
   virtual ~Distribution() = default;
+  /// This process' number (0 .. Size() - 1) and the number of processes.
+  virtual int Rank() const = 0;
+  virtual int Size() const = 0;
   /// Whether local point i is this process' own (every point of the whole cloud is owned by one process).
   virtual bool Owned(Index i) const = 0;
   /// A key of local point i unique over the whole cloud and the same on every process (the global id).
@@ -43,6 +46,23 @@ public:
   /// How far around x (an own point) the local cloud is complete: every point of the whole cloud within this
   /// distance of x is in it (the halo's radius plus x's distance to the border of the region it was grown from).
   virtual double Complete(const double x[3]) const = 0;
+  /// Computations that partition space rather than points (the surface's contouring lattice: each cell is
+  /// contoured by the process owning its centre) ask which process owns a position: every position of space by
+  /// exactly one process, the same answer on every process, and the local cloud complete around the positions a
+  /// process owns (Complete). The default (every position) suits one process only.
+  virtual bool OwnsPosition(const double x[3]) const
+  {
+    (void)x;
+    return true;
+  }
+  /// Whether every position within `radius` of x is this process' (OwnsPosition); it may answer false for a ball
+  /// it owns only where that costs exactness nowhere (a caller then merely exchanges more).
+  virtual bool OwnsBall(const double x[3], double radius) const
+  {
+    (void)x;
+    (void)radius;
+    return true;
+  }
 };
 
 /// Whether local point i is this process' own (every point when serial).
@@ -68,6 +88,9 @@ double GlobalMedian(const Distribution* d, std::vector<double> values);
 double GlobalSelect(const Distribution* d, std::vector<double> values, Index rank);
 /// The bounds (xmin, xmax, ...) of every process' finite points among n interleaved xyz (min > max when none).
 void GlobalBounds(const Distribution* d, const double* xyz, Index n, double bounds[6]);
+
+/// Every process' keys, concatenated in process order (the keys themselves when serial). Collective.
+std::vector<std::uint64_t> GatherKeys(const Distribution* d, const std::vector<std::uint64_t>& mine);
 
 /// UpdateHalo for per-point vectors of other types (values converted exactly through double).
 void UpdateHalo(const Distribution* d, std::vector<double>& values, int components = 1);

@@ -13,27 +13,92 @@ namespace meshfree
 {
 
 void DistanceToData(const NeighborGrid& grid, const std::vector<double>& vertices, std::vector<double>& distance,
-  std::vector<Index>& nearest)
+  std::vector<Index>& nearest, const Distribution* d)
 {
   const Index nv = static_cast<Index>(vertices.size() / 3);
   distance.assign(static_cast<size_t>(nv), std::numeric_limits<double>::infinity());
   nearest.assign(static_cast<size_t>(nv), -1);
-  if (grid.NumberOfValidPoints() == 0)
+  if (grid.NumberOfValidPoints() > 0)
+  {
+    ParallelFor(nv, 1024, [&](Index begin, Index end) {
+      for (Index v = begin; v < end; ++v)
+      {
+        Index id = -1;
+        double d2 = 0.0;
+        if (grid.FindKNearest(&vertices[3 * v], 1, &id, &d2) == 1)
+        {
+          distance[v] = std::sqrt(d2);
+          nearest[v] = id;
+        }
+      }
+    });
+  }
+  if (!d)
   {
     return;
   }
-  ParallelFor(nv, 1024, [&](Index begin, Index end) {
-    for (Index v = begin; v < end; ++v)
+  // Vertices far inside a filled hole: their nearest point may lie beyond the halo. Every process searches its own
+  // points for all of them; the smallest distance wins (the same bits as the serial search's).
+  std::vector<double> far;
+  std::vector<Index> farVertices;
+  for (Index v = 0; v < nv; ++v)
+  {
+    if (!(distance[v] <= d->Complete(&vertices[3 * v])))
+    {
+      far.insert(far.end(), &vertices[3 * v], &vertices[3 * v] + 3);
+      farVertices.push_back(v);
+    }
+  }
+  std::vector<double> all;
+  d->Gather(far, all);
+  const Index nq = static_cast<Index>(all.size() / 3);
+  if (nq == 0)
+  {
+    return;
+  }
+  std::vector<double> own;
+  const std::vector<Index>& order = grid.SortedOrder();
+  const double* sorted = grid.SortedPoints();
+  for (size_t s = 0; s < order.size(); ++s)
+  {
+    if (d->Owned(order[s]))
+    {
+      own.insert(own.end(), sorted + 3 * s, sorted + 3 * s + 3);
+    }
+  }
+  NeighborGrid mine;
+  mine.Build(own.data(), static_cast<Index>(own.size() / 3));
+  std::vector<double> best(static_cast<size_t>(nq), -std::numeric_limits<double>::infinity());
+  ParallelFor(nq, 256, [&](Index begin, Index end) {
+    for (Index q = begin; q < end; ++q)
     {
       Index id = -1;
       double d2 = 0.0;
-      if (grid.FindKNearest(&vertices[3 * v], 1, &id, &d2) == 1)
+      if (mine.NumberOfValidPoints() > 0 && mine.FindKNearest(&all[3 * q], 1, &id, &d2) == 1)
       {
-        distance[v] = std::sqrt(d2);
-        nearest[v] = id;
+        best[q] = -std::sqrt(d2);
       }
     }
   });
+  d->Max(best.data(), nq);
+  // This process' queries are its block of the gathered ones.
+  std::vector<double> counts;
+  d->Gather(std::vector<double>(1, static_cast<double>(farVertices.size())), counts);
+  Index offset = 0;
+  for (int r = 0; r < d->Rank(); ++r)
+  {
+    offset += static_cast<Index>(counts[r]);
+  }
+  for (size_t k = 0; k < farVertices.size(); ++k)
+  {
+    const Index v = farVertices[k];
+    const double found = -best[static_cast<size_t>(offset) + k];
+    if (found < distance[v])
+    {
+      distance[v] = found;
+      nearest[v] = -1;
+    }
+  }
 }
 
 Index KeepTriangles(TriangleMesh& mesh, const std::vector<unsigned char>& keep, const std::vector<VertexAttribute>& attributes)
@@ -151,16 +216,58 @@ std::vector<unsigned char> TrimmedTriangles(const TriangleMesh& mesh, const std:
   return keep;
 }
 
+namespace
+{
+/// Union-find over n nodes; each set is named by its smallest node.
+struct Union
+{
+  explicit Union(Index n)
+    : Parent(static_cast<size_t>(n))
+  {
+    for (Index i = 0; i < n; ++i)
+    {
+      this->Parent[i] = i;
+    }
+  }
+  Index Find(Index i)
+  {
+    while (this->Parent[i] != i)
+    {
+      this->Parent[i] = this->Parent[this->Parent[i]];
+      i = this->Parent[i];
+    }
+    return i;
+  }
+  void Join(Index a, Index b)
+  {
+    a = this->Find(a);
+    b = this->Find(b);
+    if (a != b)
+    {
+      this->Parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<Index> Parent;
+};
+
+bool PositionBefore(const double* a, const double* b)
+{
+  return std::lexicographical_compare(a, a + 3, b, b + 3);
+}
+} // namespace
+
 std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const NeighborGrid& grid,
-  const std::vector<double>& sampleLimit, Index minimumSamples, Index& pieces, Index& removedPieces)
+  const std::vector<double>& sampleLimit, Index minimumSamples, Index& pieces, Index& removedPieces,
+  const Distribution* d)
 {
   const Index nt = mesh.NumberOfTriangles();
   const Index nv = mesh.NumberOfPoints();
   std::vector<Index> component;
-  pieces = TriangleComponents(mesh.Triangles, nv, component);
+  const Index local = TriangleComponents(mesh.Triangles, nv, component);
+  pieces = local;
   removedPieces = 0;
   std::vector<unsigned char> keep(static_cast<size_t>(nt), 1);
-  if (pieces <= 1 || nv == 0)
+  if (!d && (pieces <= 1 || nv == 0))
   {
     return keep; // one piece is always kept (the best-supported one)
   }
@@ -172,9 +279,99 @@ std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const Neigh
       vertexPiece[mesh.Triangles[3 * t + c]] = component[t];
     }
   }
-  // Each sample's nearest vertex, through a grid over the vertices.
+  // Pieces as nodes: this process' local pieces follow the earlier processes' (serial: the local pieces). Each
+  // node's smallest vertex by position decides ties of support.
+  Index first = 0, nodes = local;
+  std::vector<double> smallest(static_cast<size_t>(3 * local), std::numeric_limits<double>::infinity());
+  for (Index v = 0; v < nv; ++v)
+  {
+    const Index p = vertexPiece[v];
+    if (p >= 0 && PositionBefore(&mesh.Points[3 * v], &smallest[3 * p]))
+    {
+      std::copy(&mesh.Points[3 * v], &mesh.Points[3 * v] + 3, &smallest[3 * p]);
+    }
+  }
+  std::vector<double> points(mesh.Points);
+  std::vector<Index> pointPiece(vertexPiece);
+  std::vector<double> allSmallest(smallest);
+  std::vector<Index> root;
+  if (d)
+  {
+    std::vector<double> counts;
+    d->Gather(std::vector<double>(1, static_cast<double>(local)), counts);
+    nodes = 0;
+    for (size_t r = 0; r < counts.size(); ++r)
+    {
+      first += static_cast<int>(r) < d->Rank() ? static_cast<Index>(counts[r]) : 0;
+      nodes += static_cast<Index>(counts[r]);
+    }
+    d->Gather(smallest, allSmallest);
+    // The vertices other processes' samples may find nearest (within the largest limit of this process' region's
+    // border) and the seam vertices (on cells of two processes) with their node; gathered by every process.
+    double reach = 0.0;
+    for (size_t s = 0; s < sampleLimit.size(); ++s)
+    {
+      reach = std::max(reach, std::isfinite(sampleLimit[s]) ? sampleLimit[s] : 0.0);
+    }
+    reach = GlobalMax(d, reach);
+    std::vector<double> border;
+    for (Index v = 0; v < nv; ++v)
+    {
+      if (vertexPiece[v] >= 0 && !d->OwnsBall(&mesh.Points[3 * v], reach))
+      {
+        border.insert(border.end(), &mesh.Points[3 * v], &mesh.Points[3 * v] + 3);
+        border.push_back(static_cast<double>(first + vertexPiece[v]));
+      }
+    }
+    std::vector<double> all;
+    d->Gather(border, all);
+    const size_t nb = all.size() / 4;
+    // Pieces joined through the seams: the same point on two processes.
+    std::vector<size_t> byPosition(nb);
+    for (size_t b = 0; b < nb; ++b)
+    {
+      byPosition[b] = b;
+    }
+    std::sort(byPosition.begin(), byPosition.end(), [&all](size_t a, size_t b) {
+      return PositionBefore(&all[4 * a], &all[4 * b]) || (std::equal(&all[4 * a], &all[4 * a] + 3, &all[4 * b]) && a < b);
+    });
+    Union joined(nodes);
+    for (size_t k = 1; k < nb; ++k)
+    {
+      const double* a = &all[4 * byPosition[k - 1]];
+      const double* b = &all[4 * byPosition[k]];
+      if (std::equal(a, a + 3, b))
+      {
+        joined.Join(static_cast<Index>(a[3]), static_cast<Index>(b[3]));
+      }
+    }
+    root.resize(static_cast<size_t>(nodes));
+    for (Index q = 0; q < nodes; ++q)
+    {
+      root[q] = joined.Find(q);
+    }
+    // The other processes' border vertices join the search for the nearest vertex.
+    for (size_t b = 0; b < nb; ++b)
+    {
+      const Index node = static_cast<Index>(all[4 * b + 3]);
+      if (node < first || node >= first + local)
+      {
+        points.insert(points.end(), &all[4 * b], &all[4 * b] + 3);
+        pointPiece.push_back(node - first);
+      }
+    }
+  }
+  else
+  {
+    root.resize(static_cast<size_t>(nodes));
+    for (Index q = 0; q < nodes; ++q)
+    {
+      root[q] = q;
+    }
+  }
+  // Each own sample's nearest vertex, through a grid over the vertices.
   NeighborGrid vertices;
-  vertices.Build(mesh.Points.data(), nv);
+  vertices.Build(points.data(), static_cast<Index>(points.size() / 3));
   const std::vector<Index>& order = grid.SortedOrder();
   const double* sorted = grid.SortedPoints();
   const Index ns = static_cast<Index>(order.size());
@@ -185,13 +382,14 @@ std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const Neigh
       Index id = -1;
       double d2 = 0.0;
       const double limit = sampleLimit[order[s]];
-      if (vertices.FindKNearest(sorted + 3 * s, 1, &id, &d2) == 1 && d2 <= limit * limit)
+      if (IsOwn(d, order[s]) && vertices.NumberOfValidPoints() > 0 &&
+        vertices.FindKNearest(sorted + 3 * s, 1, &id, &d2) == 1 && d2 <= limit * limit)
       {
-        owner[s] = vertexPiece[id];
+        owner[s] = root[first + pointPiece[id]];
       }
     }
   });
-  std::vector<Index> support(static_cast<size_t>(pieces), 0);
+  std::vector<std::int64_t> support(static_cast<size_t>(nodes), 0);
   for (Index s = 0; s < ns; ++s)
   {
     if (owner[s] >= 0)
@@ -199,17 +397,45 @@ std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const Neigh
       ++support[owner[s]];
     }
   }
-  // The best-supported piece is always kept (a cloud of fewer samples than minimumSamples still has a surface).
-  const Index best = static_cast<Index>(std::max_element(support.begin(), support.end()) - support.begin());
-  std::vector<unsigned char> kept(static_cast<size_t>(pieces), 0);
-  for (Index p = 0; p < pieces; ++p)
+  if (d)
   {
-    kept[p] = p == best || support[p] >= minimumSamples ? 1 : 0;
-    removedPieces += kept[p] ? 0 : 1;
+    d->Sum(support.data(), nodes);
+  }
+  // Per connected piece (named by its smallest node): its support and its smallest vertex.
+  Index best = -1;
+  std::vector<double> pieceSmallest(static_cast<size_t>(3 * nodes), std::numeric_limits<double>::infinity());
+  pieces = 0;
+  for (Index q = 0; q < nodes; ++q)
+  {
+    const Index r = root[q];
+    pieces += r == q ? 1 : 0;
+    if (PositionBefore(&allSmallest[3 * q], &pieceSmallest[3 * r]))
+    {
+      std::copy(&allSmallest[3 * q], &allSmallest[3 * q] + 3, &pieceSmallest[3 * r]);
+    }
+  }
+  // The best-supported piece is always kept (a cloud of fewer samples than minimumSamples still has a surface).
+  for (Index q = 0; q < nodes; ++q)
+  {
+    if (root[q] == q &&
+      (best < 0 || support[q] > support[best] ||
+        (support[q] == support[best] && PositionBefore(&pieceSmallest[3 * q], &pieceSmallest[3 * best]))))
+    {
+      best = q;
+    }
+  }
+  std::vector<unsigned char> kept(static_cast<size_t>(nodes), 0);
+  for (Index q = 0; q < nodes; ++q)
+  {
+    if (root[q] == q)
+    {
+      kept[q] = q == best || support[q] >= minimumSamples ? 1 : 0;
+      removedPieces += kept[q] ? 0 : 1;
+    }
   }
   for (Index t = 0; t < nt; ++t)
   {
-    keep[t] = kept[component[t]];
+    keep[t] = kept[root[first + component[t]]];
   }
   return keep;
 }

@@ -17,6 +17,7 @@
 #ifndef meshfree_DataSupport_h
 #define meshfree_DataSupport_h
 
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 #include "Surface/SparseContour.h"
 
@@ -27,8 +28,11 @@ namespace meshfree
 
 /// distance[v]: distance from vertex v to the nearest valid point of `grid`; nearest[v] its original index (-1
 /// when the grid is empty, distance +inf).
+/// Distributed (d, Common/Distribution.h; collective): the grid holds a process' points and halo; a vertex whose
+/// nearest local point is farther than the local cloud is complete around it (Distribution::Complete) gets the
+/// whole cloud's distance (the processes' own points searched for it) and nearest -1.
 void DistanceToData(const NeighborGrid& grid, const std::vector<double>& vertices, std::vector<double>& distance,
-  std::vector<Index>& nearest);
+  std::vector<Index>& nearest, const Distribution* d = nullptr);
 
 /// Keeps the triangles with keep[t] != 0 and the vertices they use (in their order); every per-vertex array in
 /// `attributes` (components per vertex given beside it) is compacted alike. Returns the triangles removed.
@@ -52,8 +56,15 @@ std::vector<unsigned char> TrimmedTriangles(const TriangleMesh& mesh, const std:
 /// Triangles to keep: those of pieces (connected through vertices) that at least `minimumSamples` samples
 /// support (the best-supported piece is always kept). A sample (point s of `grid`, limit sampleLimit[s] in the grid's original order) supports the piece
 /// of its nearest vertex when that vertex is within the limit. `pieces` and `removedPieces` receive the counts.
+/// Distributed (d; collective): the mesh is a process' part of the whole (its lattice cells', SparseContour.h), the
+/// grid its points and halo; pieces are the whole mesh's (joined across the processes through their seam
+/// vertices, the same points on both sides), each own sample counts for the piece of its nearest vertex of the
+/// whole mesh (the other processes' vertices near this process' region are gathered), and the counts and
+/// decisions are the whole mesh's. The best-supported piece (ties: the one with the smallest vertex by (x, y, z))
+/// is kept.
 std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const NeighborGrid& grid,
-  const std::vector<double>& sampleLimit, Index minimumSamples, Index& pieces, Index& removedPieces);
+  const std::vector<double>& sampleLimit, Index minimumSamples, Index& pieces, Index& removedPieces,
+  const Distribution* d = nullptr);
 
 } // namespace meshfree
 

@@ -12,7 +12,7 @@ namespace meshfree
 {
 
 void FilledField::Set(const ImplicitField& fit, const NeighborGrid& grid, const double* supports, const double* points,
-  const double* normals, const double* areas, Index count)
+  const double* normals, const double* areas, Index count, const Distribution* d)
 {
   this->Fit = &fit;
   // The MLS fit leaves every sample within its query radius (>= each support) in the scratch.
@@ -27,7 +27,7 @@ void FilledField::Set(const ImplicitField& fit, const NeighborGrid& grid, const 
   for (size_t s = 0; s < order.size(); ++s)
   {
     const double h = supports[order[s]];
-    if (h > 0.0 && std::isfinite(h))
+    if (h > 0.0 && std::isfinite(h) && IsOwn(d, order[s]))
     {
       valid.push_back(h);
     }
@@ -37,10 +37,9 @@ void FilledField::Set(const ImplicitField& fit, const NeighborGrid& grid, const 
   // winding number's film meet at an angle, folding the surface (measured: dihedral angles up to 178 degrees in
   // the filled part of a virtual scan, against 102-110 with the median).
   this->InverseScale = 0.0;
-  if (!valid.empty())
+  if (GlobalSum(d, static_cast<Index>(valid.size())) > 0)
   {
-    std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
-    this->InverseScale = 1.0 / valid[valid.size() / 2];
+    this->InverseScale = 1.0 / GlobalMedian(d, std::move(valid)); // the whole cloud's (exact when distributed)
   }
   double b[6];
   grid.GetBounds(b);

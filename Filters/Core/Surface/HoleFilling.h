@@ -22,6 +22,7 @@
 #ifndef meshfree_HoleFilling_h
 #define meshfree_HoleFilling_h
 
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 #include "Surface/ImplicitField.h"
 #include "Surface/WindingNumber.h"
@@ -41,7 +42,7 @@ public:
   /// unit normals and areas (3, 3, 1 per point, same order) define the winding number, whose tree is built on
   /// the first evaluation that needs it (a well-sampled closed cloud may never need it).
   void Set(const ImplicitField& fit, const NeighborGrid& grid, const double* supports, const double* points,
-    const double* normals, const double* areas, Index count);
+    const double* normals, const double* areas, Index count, const Distribution* d = nullptr);
 
   /// The winding number (built on first use; thread-safe).
   const WindingNumber& Winding() const;

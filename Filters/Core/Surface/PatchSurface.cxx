@@ -83,7 +83,7 @@ bool FitHeights(const std::vector<double>& uvh, const std::vector<double>& w, do
 }
 } // namespace
 
-void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, const double* radii)
+void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, const double* radii, const Distribution* d)
 {
   this->Frames.clear();
   this->Heights.clear();
@@ -97,18 +97,19 @@ void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, con
   for (Index s = 0; s < nv; ++s)
   {
     const Index id = order[s];
-    if (radii[id] > 0.0 && std::isfinite(radii[id]))
+    if (radii[id] > 0.0 && std::isfinite(radii[id]) && IsOwn(d, id))
     {
       valid.push_back(radii[id]);
     }
   }
-  if (valid.empty())
+  // The median of the whole cloud's supports (an exact selection when distributed: the same as serial).
+  const Index supported = GlobalSum(d, static_cast<Index>(valid.size()));
+  const double rho = supported > 0 ? GlobalMedian(d, std::move(valid)) : 0.0;
+  if (supported == 0)
   {
     this->Centres.Build(nullptr, 0);
     return;
   }
-  std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
-  const double rho = valid[valid.size() / 2];
   const double patch = 0.5 * rho;
 
   // Points bucketed by coarse cell (relative to the bounds' minimum).
@@ -134,6 +135,7 @@ void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, con
   }
   std::sort(keyed.begin(), keyed.end());
   std::vector<double> centres, frames;
+  std::vector<unsigned char> own; // distributed: the patch's first point is this process' own
   for (size_t i = 0; i < keyed.size();)
   {
     size_t j = i;
@@ -163,6 +165,7 @@ void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, con
       }
       Tangents(frame + 6, frame, frame + 3);
       frames.insert(frames.end(), frame, frame + 9);
+      own.push_back(IsOwn(d, order[keyed[i].second]) ? 1 : 0);
     }
     i = j;
   }
@@ -256,6 +259,18 @@ void PatchSurface::SetCloud(const NeighborGrid& grid, const double* normals, con
     this->Heights.insert(this->Heights.end(), &heights[6 * p], &heights[6 * p] + 6);
     this->Radius.push_back(rho);
   }
+  // The centres' grid framed by the whole cloud's patches (the same cells, hence the same sums, as serial).
+  std::vector<double> owned;
+  for (Index p = 0; p < candidates; ++p)
+  {
+    if (kept[p] && own[p])
+    {
+      owned.insert(owned.end(), &centres[3 * p], &centres[3 * p] + 3);
+    }
+  }
+  double frame[6];
+  GlobalBounds(d, owned.data(), static_cast<Index>(owned.size() / 3), frame);
+  this->Centres.SetFrame(frame, GlobalSum(d, static_cast<Index>(owned.size() / 3)));
   this->Centres.Build(this->Positions.data(), static_cast<Index>(this->Radius.size()));
   this->QueryRadius = rho;
 }

@@ -28,6 +28,7 @@
 #ifndef meshfree_PatchSurface_h
 #define meshfree_PatchSurface_h
 
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 #include "Surface/ImplicitField.h"
 
@@ -40,8 +41,10 @@ class PatchSurface : public ImplicitField
 {
 public:
   /// The cloud as for PointSetSurface::SetCloud(): grid, unit outward normals and fit supports (caller's
-  /// order; points with a zero normal or radius are ignored).
-  void SetCloud(const NeighborGrid& grid, const double* normals, const double* radii);
+  /// order; points with a zero normal or radius are ignored). Distributed (d, as PointSetSurface::SetCloud()): the
+  /// patch radius is the whole cloud's median support and the patches' cells the frame's, so the patches near a
+  /// process' own points are the serial ones.
+  void SetCloud(const NeighborGrid& grid, const double* normals, const double* radii, const Distribution* d = nullptr);
 
   bool Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& scratch) const override;
 

@@ -546,7 +546,7 @@ bool SparseContour::CellOf(const double x[3], const ContourOptions& options, Ind
 }
 
 bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> seeds, const ContourOptions& options,
-  TriangleMesh& mesh, ContourReport& report, const ProgressCallback& progress)
+  TriangleMesh& mesh, ContourReport& report, const ProgressCallback& progress, const Distribution* d)
 {
   mesh = TriangleMesh();
   report = ContourReport();
@@ -555,8 +555,6 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
     return false;
   }
   Lattice lattice(options);
-  std::sort(seeds.begin(), seeds.end());
-  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
   // Seeds must leave room for their upper corners.
   seeds.erase(std::remove_if(seeds.begin(), seeds.end(),
                 [](std::uint64_t key) {
@@ -566,11 +564,47 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
                     c[2] + 1 > kMaximumCoordinate;
                 }),
     seeds.end());
+  // Distributed: the cells whose centre this process owns; the others are handed to their owners.
+  const auto owns = [d, &options](std::uint64_t key) {
+    Index c[3];
+    UnpackCell(key, c);
+    double x[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      x[a] = options.Origin[a] + (static_cast<double>(c[a]) + 0.5) * options.CellSize;
+    }
+    return d->OwnsPosition(x);
+  };
 
   // Continuation rounds (evaluation is most of the work: progress 0 .. 0.85).
   std::vector<std::uint64_t> fresh = std::move(seeds);
-  while (!fresh.empty())
+  bool aborted = false;
+  while (true)
   {
+    if (d)
+    {
+      std::vector<std::uint64_t> mine, away;
+      for (const std::uint64_t key : fresh)
+      {
+        (owns(key) ? mine : away).push_back(key);
+      }
+      for (const std::uint64_t key : GatherKeys(d, away))
+      {
+        Index c[3];
+        UnpackCell(key, c);
+        if (owns(key) && !lattice.IsActive(c[0], c[1], c[2]))
+        {
+          mine.push_back(key);
+        }
+      }
+      fresh.swap(mine);
+    }
+    std::sort(fresh.begin(), fresh.end());
+    fresh.erase(std::unique(fresh.begin(), fresh.end()), fresh.end());
+    if (GlobalSum(d, static_cast<Index>(fresh.size())) == 0)
+    {
+      break;
+    }
     if (report.Rounds >= options.MaximumRounds)
     {
       report.RoundLimitReached = true;
@@ -580,13 +614,29 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
     lattice.Activate(fresh);
     report.ActiveCells += static_cast<Index>(fresh.size());
     const double fraction = 0.85 * (1.0 - 1.0 / (1.0 + report.Rounds));
-    if (!EvaluatePending(lattice, field, report, progress, fraction))
+    // Aborting is local: a distributed process stops growing but takes part in the rounds until all are done.
+    aborted = aborted || !EvaluatePending(lattice, field, report, progress, fraction);
+    if (aborted)
     {
-      report.Aborted = true;
-      mesh = TriangleMesh();
-      return false;
+      fresh.clear();
+      lattice.PendingBlocks.clear();
+      if (!d)
+      {
+        break;
+      }
+      continue;
     }
     fresh = GrowthFront(lattice, fresh, report.LatticeEdgeReached);
+  }
+  if (d)
+  {
+    report.LatticeEdgeReached = GlobalMax(d, report.LatticeEdgeReached ? 1.0 : 0.0) > 0.0;
+  }
+  if (aborted)
+  {
+    report.Aborted = true;
+    mesh = TriangleMesh();
+    return false;
   }
   report.Blocks = static_cast<Index>(lattice.Blocks.size());
   lattice.LinkNeighbors();

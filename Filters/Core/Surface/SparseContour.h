@@ -28,10 +28,19 @@
  * crossing edge, at the linear zero of the edge's two corner values, kept at least ClampFraction of the edge
  * from either end so no triangle degenerates) is created once, by the block owning the edge's lower corner;
  * blocks and cells are processed in key order, so the output does not depend on the thread count.
+ *
+ * Distributed (a Distribution d): each process activates only the cells whose centre it owns
+ * (Distribution::OwnsPosition); a crossed face that leads to another process' cell hands that cell over at the
+ * start of the next round (every process gathers the handed-over keys and keeps its own), and the rounds go on
+ * until no process has a fresh cell. The active set, and the round in which each cell joins it, are the serial
+ * run's; a corner shared with another process' cell is evaluated on both sides from the same neighbours, to the
+ * same bits, so the processes' meshes meet without cracks: their union is the serial mesh (seam vertices are
+ * the same points on both sides).
  */
 #ifndef meshfree_SparseContour_h
 #define meshfree_SparseContour_h
 
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 #include "Common/Progress.h"
 #include "Surface/ImplicitField.h"
@@ -83,9 +92,11 @@ public:
   static bool CellOf(const double x[3], const ContourOptions& options, Index cell[3]);
 
   /// Contours `field` from the seed cells (keys from CellKey(); duplicates allowed). The mesh is replaced.
-  /// Returns false when aborted (the mesh is then empty) or when the options are invalid.
+  /// Returns false when aborted (the mesh is then empty) or when the options are invalid. Distributed (d, see
+  /// above; collective): seeds may be any process' cells, the mesh is this process' cells' triangles.
   bool Run(const ImplicitField& field, std::vector<std::uint64_t> seeds, const ContourOptions& options,
-    TriangleMesh& mesh, ContourReport& report, const ProgressCallback& progress = ProgressCallback());
+    TriangleMesh& mesh, ContourReport& report, const ProgressCallback& progress = ProgressCallback(),
+    const Distribution* d = nullptr);
 };
 
 /// The triangles of one cell, as cell edges (their crossing points) and loop centres.

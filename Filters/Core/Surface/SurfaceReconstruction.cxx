@@ -114,7 +114,8 @@ void ChooseLattice(const NeighborGrid& grid, double cell, double margin, Contour
 /// near the data gets many seeds, yet only the cells the surface crosses are evaluated (seeding every
 /// occupied cell would evaluate the whole noisy shell of points, several cells thick).
 std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitField& field, const ContourOptions& lattice,
-  double reach, const std::vector<unsigned char>& chosen, double farther = std::numeric_limits<double>::infinity())
+  double reach, const std::vector<unsigned char>& chosen, double farther = std::numeric_limits<double>::infinity(),
+  const Distribution* d = nullptr)
 {
   const std::vector<Index>& order = grid.SortedOrder();
   const double* sorted = grid.SortedPoints();
@@ -135,6 +136,11 @@ std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitFie
                  [](const std::pair<std::uint64_t, Index>& a, const std::pair<std::uint64_t, Index>& b) {
                    return a.first == b.first;
                  }),
+    blocks.end());
+  // Distributed: a block's representative is the whole cloud's (the sorted order is the framed grid's, the same
+  // as serial; the halo holds every point of a block with an own point); its owner seeds it.
+  blocks.erase(std::remove_if(blocks.begin(), blocks.end(),
+                 [d, &order](const std::pair<std::uint64_t, Index>& b) { return !IsOwn(d, order[b.second]); }),
     blocks.end());
   const Index count = static_cast<Index>(blocks.size());
   std::vector<std::uint64_t> seeds(static_cast<size_t>(count), 0);
@@ -178,6 +184,52 @@ std::vector<std::uint64_t> SeedCells(const NeighborGrid& grid, const ImplicitFie
     }
   }
   return kept;
+}
+
+/// |sum a_i n_i| / sum a_i over the (own) samples, 1 without area. The sums are exact integer sums of the terms
+/// rounded to a common fixed point (2^-62 of the largest term times the number of terms below it), so that they
+/// do not depend on the order of the points nor on how they are split among processes.
+double OpenShare(const NeighborGrid& grid, const std::vector<double>& areas, const std::vector<double>& normals,
+  const Distribution* d)
+{
+  const std::vector<Index>& order = grid.SortedOrder();
+  double largest = 0.0;
+  Index count = 0;
+  for (const Index i : order)
+  {
+    if (areas[i] > 0.0 && std::isfinite(areas[i]) && IsOwn(d, i))
+    {
+      largest = std::max(largest, areas[i]);
+      ++count;
+    }
+  }
+  largest = GlobalMax(d, largest);
+  count = GlobalSum(d, count);
+  if (!(largest > 0.0) || count == 0)
+  {
+    return 1.0;
+  }
+  const int bits = 62 - static_cast<int>(std::ceil(std::log2(static_cast<double>(count) + 1.0)));
+  const double scale = std::ldexp(1.0, bits) / largest;
+  std::int64_t sums[4] = { 0, 0, 0, 0 };
+  for (const Index i : order)
+  {
+    if (areas[i] > 0.0 && std::isfinite(areas[i]) && IsOwn(d, i))
+    {
+      sums[0] += std::llround(areas[i] * scale);
+      for (int a = 0; a < 3; ++a)
+      {
+        sums[1 + a] += std::llround(areas[i] * normals[3 * i + a] * scale);
+      }
+    }
+  }
+  if (d)
+  {
+    d->Sum(sums, 4);
+  }
+  const double total = static_cast<double>(sums[0]);
+  const double dipole[3] = { static_cast<double>(sums[1]), static_cast<double>(sums[2]), static_cast<double>(sums[3]) };
+  return total > 0.0 ? std::sqrt(dipole[0] * dipole[0] + dipole[1] * dipole[1] + dipole[2] * dipole[2]) / total : 1.0;
 }
 
 /// Moves the vertices onto the surface and sets their normals; vertices that cannot be projected keep
@@ -302,25 +354,66 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   using Clock = std::chrono::steady_clock;
   const auto seconds = [](Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); };
   auto start = Clock::now();
+  const Distribution* processes = options.Processes;
+  if (processes && options.Method == SurfaceMethod::SPH)
+  {
+    error = "The SPH surface is not distributed yet.";
+    return false;
+  }
   NeighborGrid grid;
+  if (options.Framed)
+  {
+    grid.SetFrame(options.FrameBounds, options.FramePoints);
+  }
   // The default layout (each cell's points by position): every loop over the sorted points, the seeds, the fits'
   // neighbour lists and sums follow the positions, not the input order (issue 24).
   grid.Build(input.Points, input.Count);
   report.InvalidPoints = grid.NumberOfInvalidPoints();
-  if (grid.NumberOfValidPoints() == 0)
+  if (processes)
+  {
+    report.InvalidPoints = 0;
+    for (Index i = 0; i < input.Count; ++i)
+    {
+      const double* p = input.Points + 3 * i;
+      report.InvalidPoints += processes->Owned(i) && !(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
+    }
+  }
+  if (GlobalSum(processes, grid.NumberOfValidPoints()) == 0)
   {
     return true;
   }
   // Point-set surfaces work on the distinct points (UniqueCloud.h); particles keep their duplicates' mass.
+  // Distributed, every process does so when one has duplicates (the same frame, the same distinct cloud).
   UniqueCloud unique;
   SurfaceInput distinct = input;
-  if (options.Method != SurfaceMethod::SPH && MergeDuplicates(grid, input.Points, input.Normals, unique))
+  std::unique_ptr<DistinctDistribution> distinctProcesses;
+  const Distribution* d = processes;
+  if (options.Method != SurfaceMethod::SPH)
   {
-    report.Duplicates = unique.Duplicates;
-    distinct.Points = unique.Points.data();
-    distinct.Count = static_cast<Index>(unique.Points.size() / 3);
-    distinct.Normals = input.Normals ? unique.Normals.data() : nullptr;
-    grid.Build(distinct.Points, distinct.Count);
+    const bool merged = MergeDuplicates(grid, input.Points, input.Normals, unique);
+    if (GlobalMax(processes, merged ? 1.0 : 0.0) > 0.0)
+    {
+      if (!merged)
+      {
+        MergeDuplicates(grid, input.Points, input.Normals, unique, true);
+      }
+      report.Duplicates = unique.Duplicates;
+      if (processes)
+      {
+        distinctProcesses.reset(new DistinctDistribution(*processes, unique, input.Count));
+        d = distinctProcesses.get();
+        report.Duplicates = distinctProcesses->OwnDuplicates();
+      }
+      distinct.Points = unique.Points.data();
+      distinct.Count = static_cast<Index>(unique.Points.size() / 3);
+      distinct.Normals = input.Normals ? unique.Normals.data() : nullptr;
+      // The same frame as the input's (serial too: the grid's cells do not depend on how many were duplicates).
+      double frame[6];
+      Index framePoints = 0;
+      grid.GetFrame(frame, framePoints);
+      grid.SetFrame(frame, framePoints);
+      grid.Build(distinct.Points, distinct.Count);
+    }
   }
 
   std::unique_ptr<ImplicitField> field; // the surface contoured
@@ -371,12 +464,14 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     no.NeighborCount = options.NeighborCount;
     no.SupportRadius = options.SupportRadius;
     no.WideNormals = false; // the fits' own radius: wide jets take in both sides of thin parts
+    no.Processes = d;
     if (!EstimateNormals(grid, no, normals, Stage(progress, 0.0, 0.15)) && progress && !progress(0.15))
     {
       report.Aborted = true;
       return false;
     }
     report.Scale = normals.Scale;
+    report.Shortfall = std::max(report.Shortfall, normals.Shortfall);
     if (distinct.Normals)
     {
       report.PointsWithoutNormal = TakeNormals(distinct, normals);
@@ -385,11 +480,14 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     {
       report.NormalsEstimated = true;
       std::vector<double> confidence;
-      report.Orientation = OrientNormals(grid, normals, OrientationOptions(), confidence);
-      report.PointsWithoutNormal = normals.InvalidCount - grid.NumberOfInvalidPoints();
+      OrientationOptions orientation;
+      orientation.Processes = d;
+      report.Orientation = OrientNormals(grid, normals, orientation, confidence);
+      report.Shortfall = std::max(report.Shortfall, report.Orientation.Shortfall);
+      report.PointsWithoutNormal = normals.InvalidCount - (d ? 0 : grid.NumberOfInvalidPoints());
     }
     support = FitSupports(
-      normals, options.SupportScale, options.NoiseScale, options.SupportRadius > 0.0, report.SupportRadius);
+      normals, options.SupportScale, options.NoiseScale, options.SupportRadius > 0.0, report.SupportRadius, d);
     if (!(cell > 0.0))
     {
       // 1.5 sample spacings (about 0.7 vertices per sample), or a quarter of the fits' support (finer detail
@@ -405,40 +503,37 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     if (options.Method == SurfaceMethod::MLS)
     {
       auto apss = std::make_unique<PointSetSurface>();
-      apss->SetCloud(grid, normals.Normals.data(), support.data());
+      apss->SetCloud(grid, normals.Normals.data(), support.data(), d);
       field = std::move(apss);
     }
     else
     {
       auto patches = std::make_unique<PatchSurface>();
-      patches->SetCloud(grid, normals.Normals.data(), support.data());
+      patches->SetCloud(grid, normals.Normals.data(), support.data(), d);
       field = std::move(patches);
     }
     // How closed the cloud is, from the samples the fits use, and the continuation of the fits across the
     // regions without samples (HoleFilling.h; the winding number's tree is built when first needed).
     const auto fillStart = Clock::now();
     areas = SampleAreas(normals.NeighborDistance, options.NeighborCount);
-    double total = 0.0, dipole[3] = { 0.0, 0.0, 0.0 };
     for (size_t i = 0; i < areas.size(); ++i)
     {
       areas[i] = support[i] > 0.0 && !normals.Outlier[i] ? areas[i] : 0.0;
     }
-    for (const Index i : grid.SortedOrder()) // summed in the grid's order, which depends on the positions only
-    {
-      total += areas[i];
-      for (int a = 0; a < 3; ++a)
-      {
-        dipole[a] += areas[i] * normals.Normals[3 * i + a];
-      }
-    }
-    report.OpenShare =
-      total > 0.0 ? std::sqrt(dipole[0] * dipole[0] + dipole[1] * dipole[1] + dipole[2] * dipole[2]) / total : 1.0;
+    report.OpenShare = OpenShare(grid, areas, normals.Normals, d);
     report.HolesFilled = options.HoleFilling == HoleFillingMode::On ||
       (options.HoleFilling == HoleFillingMode::Auto && report.OpenShare < options.ClosedBelow);
+    if (report.HolesFilled && processes)
+    {
+      // The winding number sums over the whole cloud: not distributed yet (every process takes this decision).
+      report.NotDistributed = true;
+      error = "Filling holes needs the whole cloud on every process (HoleFilling is not distributed yet).";
+      return false;
+    }
     if (report.HolesFilled)
     {
       auto filled = std::make_unique<FilledField>();
-      filled->Set(*field, grid, support.data(), distinct.Points, normals.Normals.data(), areas.data(), distinct.Count);
+      filled->Set(*field, grid, support.data(), distinct.Points, normals.Normals.data(), areas.data(), distinct.Count, d);
       fit = std::move(field);
       field = std::move(filled);
     }
@@ -449,7 +544,7 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       seeding[i] = seeding[i] && !normals.Outlier[i] && support[i] > 0.0;
     }
     report.Outliers = normals.OutlierCount;
-    seeds = SeedCells(grid, *field, lattice, report.SupportRadius, seeding);
+    seeds = SeedCells(grid, *field, lattice, report.SupportRadius, seeding, std::numeric_limits<double>::infinity(), d);
     if (progress && !progress(0.2))
     {
       report.Aborted = true;
@@ -459,7 +554,7 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   report.CellSize = lattice.CellSize;
   report.SetupSeconds = seconds(start);
   start = Clock::now();
-  if (!SparseContour().Run(*field, std::move(seeds), lattice, mesh, report.Contour, Stage(progress, 0.2, 0.85)))
+  if (!SparseContour().Run(*field, std::move(seeds), lattice, mesh, report.Contour, Stage(progress, 0.2, 0.85), d))
   {
     report.Aborted = report.Contour.Aborted;
     mesh = SurfaceMesh();
@@ -470,10 +565,20 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     return false;
   }
   report.ContourSeconds = seconds(start);
+  if (d)
+  {
+    // The fits read the samples within the largest support (at most 3 x the median) of a corner, up to a cell
+    // from a vertex, and the projection moves a vertex by at most a cell.
+    const double reach = 3.0 * report.SupportRadius + 2.0 * lattice.CellSize;
+    for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
+    {
+      report.Shortfall = std::max(report.Shortfall, Shortfall(d, &mesh.Points[3 * v], reach));
+    }
+  }
   start = Clock::now();
   report.ProjectedVertices = ProjectVertices(*field, lattice.CellSize, options.ProjectVertices, mesh);
   std::vector<Index> nearest;
-  DistanceToData(grid, mesh.Points, mesh.DistanceToData, nearest);
+  DistanceToData(grid, mesh.Points, mesh.DistanceToData, nearest, d);
   if (options.Method != SurfaceMethod::SPH)
   {
     // How far from a sample the surface still counts as on the data: TrimSpacings local spacings (from the
@@ -506,8 +611,9 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     if (options.RemoveStrayPieces && mesh.NumberOfTriangles() > 0)
     {
       const Index before = mesh.NumberOfTriangles();
-      const std::vector<unsigned char> keep = SupportedPieces(
-        mesh, grid, limit, std::min<Index>(options.NeighborCount, grid.NumberOfValidPoints()), report.Pieces, report.RemovedPieces);
+      const std::vector<unsigned char> keep = SupportedPieces(mesh, grid, limit,
+        std::min<Index>(options.NeighborCount, GlobalSum(d, static_cast<Index>(distinct.Count))), report.Pieces,
+        report.RemovedPieces, d);
       KeepTriangles(mesh, keep, attributes);
       report.RemovedTriangles = before - mesh.NumberOfTriangles();
     }

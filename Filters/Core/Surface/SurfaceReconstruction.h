@@ -42,6 +42,7 @@
 #include "Surface/SparseContour.h"
 #include "Surface/SurfaceNormals.h"
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,14 @@ struct SurfaceOptions
   double ClosedBelow = 0.45;   // Auto: the cloud encloses a volume when its OpenShare is below this
   double TrimSpacings = 2.5;   // MLS/WLS, holes left open: the border stays within this many local spacings
   bool RemoveStrayPieces = true; // drop pieces fewer than NeighborCount samples support (DataSupport.h)
+  // Distributed (Common/Distribution.h): the input is this process' points and their halo; the grid is framed by
+  // the whole cloud (FrameBounds: the bounds of its valid points, FramePoints: their number; NeighborGrid::SetFrame);
+  // each process contours the lattice cells whose centre it owns (Distribution::OwnsPosition) and the mesh is
+  // their triangles; normals, fits and statistics are the whole cloud's. Null: serial.
+  const Distribution* Processes = nullptr;
+  bool Framed = false;
+  double FrameBounds[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 };
+  Index FramePoints = 0;
 };
 
 struct SurfaceInput
@@ -121,6 +130,10 @@ struct SurfaceReport
   double SetupSeconds = 0.0;
   double ContourSeconds = 0.0;
   double ProjectionSeconds = 0.0;
+  // Distributed: how far beyond the complete part of the local cloud a computation reached (Distribution.h's
+  // Shortfall; > 0: widen the halo by it and rerun); -infinity when serial.
+  double Shortfall = -HUGE_VAL;
+  bool NotDistributed = false; // distributed: this case needs the whole cloud on every process (false returned)
   bool Aborted = false;
 };
 

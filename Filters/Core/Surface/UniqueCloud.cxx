@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Surface/UniqueCloud.h"
 
+#include <algorithm>
+
 namespace meshfree
 {
 
@@ -38,6 +40,52 @@ bool MergeDuplicates(
     }
   }
   return true;
+}
+
+DistinctDistribution::DistinctDistribution(const Distribution& base, const UniqueCloud& unique, Index n)
+  : Base(base)
+  , Unique(unique)
+  , Representative(unique.Points.size() / 3, -1)
+{
+  for (Index i = 0; i < n; ++i)
+  {
+    const Index u = unique.Unique[i];
+    if (u >= 0 && (this->Representative[u] < 0 || base.Key(i) < base.Key(this->Representative[u])))
+    {
+      this->Representative[u] = i;
+    }
+  }
+}
+
+void DistinctDistribution::UpdateHalo(double* values, int components) const
+{
+  const Index n = static_cast<Index>(this->Unique.Unique.size());
+  std::vector<double> expanded(static_cast<size_t>(n * components), 0.0);
+  for (Index i = 0; i < n; ++i)
+  {
+    const Index u = this->Unique.Unique[i];
+    if (u >= 0)
+    {
+      std::copy_n(values + u * components, components, &expanded[static_cast<size_t>(i * components)]);
+    }
+  }
+  this->Base.UpdateHalo(expanded.data(), components);
+  for (size_t u = 0; u < this->Representative.size(); ++u)
+  {
+    std::copy_n(&expanded[static_cast<size_t>(this->Representative[u] * components)], components,
+      values + u * components);
+  }
+}
+
+Index DistinctDistribution::OwnDuplicates() const
+{
+  Index count = 0;
+  for (size_t i = 0; i < this->Unique.Unique.size(); ++i)
+  {
+    const Index u = this->Unique.Unique[i];
+    count += u >= 0 && this->Base.Owned(static_cast<Index>(i)) && this->Representative[u] != static_cast<Index>(i);
+  }
+  return count;
 }
 
 } // namespace meshfree

@@ -6,6 +6,7 @@
 #ifndef meshfree_UniqueCloud_h
 #define meshfree_UniqueCloud_h
 
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 
 #include <vector>
@@ -26,6 +27,38 @@ struct UniqueCloud
 /// whether it filled it (unique untouched otherwise).
 bool MergeDuplicates(
   const NeighborGrid& grid, const double* xyz, const double* normals, UniqueCloud& unique, bool always = false);
+
+/// A distributed cloud's distinct points (UniqueCloud over a process' piece and halo): each is owned where its
+/// member with the smallest key is, and its halo values are that member's owner's; positions belong to the
+/// processes as in the base distribution.
+class DistinctDistribution : public Distribution
+{
+public:
+  /// `base` and `unique` (filled from the n local points) must outlive this object.
+  DistinctDistribution(const Distribution& base, const UniqueCloud& unique, Index n);
+  int Rank() const override { return this->Base.Rank(); }
+  int Size() const override { return this->Base.Size(); }
+  bool Owned(Index u) const override { return this->Base.Owned(this->Representative[u]); }
+  std::int64_t Key(Index u) const override { return this->Base.Key(this->Representative[u]); }
+  void Sum(double* values, Index count) const override { this->Base.Sum(values, count); }
+  void Sum(std::int64_t* values, Index count) const override { this->Base.Sum(values, count); }
+  void Max(double* values, Index count) const override { this->Base.Max(values, count); }
+  void Gather(const std::vector<double>& mine, std::vector<double>& all) const override
+  {
+    this->Base.Gather(mine, all);
+  }
+  double Complete(const double x[3]) const override { return this->Base.Complete(x); }
+  bool OwnsPosition(const double x[3]) const override { return this->Base.OwnsPosition(x); }
+  bool OwnsBall(const double x[3], double radius) const override { return this->Base.OwnsBall(x, radius); }
+  void UpdateHalo(double* values, int components) const override;
+  /// This process' own input points that are not their distinct point's representative.
+  Index OwnDuplicates() const;
+
+private:
+  const Distribution& Base;
+  const UniqueCloud& Unique;
+  std::vector<Index> Representative;
+};
 
 } // namespace meshfree
 
