@@ -22,9 +22,12 @@
 #include "vtkStringArray.h"
 #include "vtkTypeInt64Array.h"
 
+#include "vtkMeshFreeHaloDistribution.h"
 #include "vtkMeshFreePieces.h"
+#include "vtkMeshFreeSlabs.h"
 
 #include "Approximation/Approximation.h"
+#include "Surface/DataSupport.h"
 #include "Surface/MeshTopology.h"
 #include "Surface/SurfaceReconstruction.h"
 
@@ -59,6 +62,15 @@ struct vtkMeshlessSurface::Cloud
   int Columns = 0;
   std::vector<double> Values;
   std::string ActiveScalars;
+};
+
+/// What one row of the cloud holds: coordinates, then normals, volume and the arrays' values as agreed.
+struct vtkMeshlessSurface::Layout
+{
+  bool UseNormals = false;
+  bool UseVolumes = false;
+  int Width = 3;
+  std::vector<double> Rows; // this rank's points, one row each
 };
 
 /// What the core returned, and what the VTK layer added.
@@ -167,7 +179,8 @@ int vtkMeshlessSurface::FillInputPortInformation(int, vtkInformation* info)
   return 1;
 }
 
-void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessController* controller, Cloud& cloud)
+void vtkMeshlessSurface::PrepareInput(
+  vtkPointSet* input, vtkMultiProcessController* controller, Cloud& cloud, Layout& rowLayout)
 {
   // Under MPI every rank takes part in every collective call here, with an empty piece too, and agrees on what the
   // rows hold: an array is used when every rank with points has it.
@@ -278,9 +291,13 @@ void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessControll
   vtkDataArray* scalars = pd->GetScalars();
   cloud.ActiveScalars = scalars && scalars->GetName() ? scalars->GetName() : "";
 
-  // One row per point: coordinates, normals, volume, the arrays' values; gathered whole under MPI.
+  // One row per point: coordinates, normals, volume, the arrays' values.
   const int width = 3 + (useNormals ? 3 : 0) + (useVolumes ? 1 : 0) + cloud.Columns;
-  std::vector<double> rows(static_cast<size_t>(n) * width);
+  rowLayout.UseNormals = useNormals;
+  rowLayout.UseVolumes = useVolumes;
+  rowLayout.Width = width;
+  std::vector<double>& rows = rowLayout.Rows;
+  rows.assign(static_cast<size_t>(n) * width, 0.0);
   for (vtkIdType i = 0; i < n; ++i)
   {
     double* row = &rows[static_cast<size_t>(i) * width];
@@ -304,9 +321,14 @@ void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessControll
       }
     }
   }
-  const vtkMeshFreePieces::GatheredCloud all = vtkMeshFreePieces::GatherCloud(controller, input, rows, width);
-  rows.clear();
-  const vtkIdType count = all.Count;
+}
+
+namespace
+{
+/// The cloud's arrays from `count` rows of the layout.
+template <class Cloud>
+void UnpackRows(const double* rows, vtkIdType count, int width, bool useNormals, bool useVolumes, Cloud& cloud)
+{
   cloud.Count = count;
   cloud.Points.resize(3 * static_cast<size_t>(count));
   cloud.Normals.resize(useNormals ? 3 * static_cast<size_t>(count) : 0);
@@ -315,7 +337,7 @@ void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessControll
   cloud.InvalidVolumes = 0;
   for (vtkIdType i = 0; i < count; ++i)
   {
-    const double* row = &all.Rows[static_cast<size_t>(i) * width];
+    const double* row = rows + static_cast<size_t>(i) * width;
     std::copy_n(row, 3, &cloud.Points[3 * i]);
     row += 3;
     if (useNormals)
@@ -331,8 +353,20 @@ void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessControll
     std::copy_n(row, cloud.Columns, &cloud.Values[static_cast<size_t>(i) * cloud.Columns]);
   }
 }
+} // namespace
 
-void vtkMeshlessSurface::ReportReconstruction(const Cloud& cloud, const Result& result)
+void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessController* controller, Cloud& cloud)
+{
+  // Gathered whole under MPI.
+  Layout layout;
+  this->PrepareInput(input, controller, cloud, layout);
+  const vtkMeshFreePieces::GatheredCloud all =
+    vtkMeshFreePieces::GatherCloud(controller, input, layout.Rows, layout.Width);
+  std::vector<double>().swap(layout.Rows);
+  UnpackRows(all.Rows.data(), all.Count, layout.Width, layout.UseNormals, layout.UseVolumes, cloud);
+}
+
+void vtkMeshlessSurface::ReportReconstruction(const Cloud& cloud, const Result& result, vtkIdType boundaryEdges)
 {
   const meshfree::SurfaceReport& report = result.Report;
   const vtkIdType valid = cloud.Count - report.InvalidPoints;
@@ -381,9 +415,13 @@ void vtkMeshlessSurface::ReportReconstruction(const Cloud& cloud, const Result& 
   // Boundary edges need a pass over the mesh: only where the contouring or the trimming can have left some.
   const bool maybeOpen = contour.UndefinedCorners > 0 || contour.RoundLimitReached || contour.LatticeEdgeReached ||
     report.TrimmedTriangles > 0;
-  const meshfree::MeshTopology topology = maybeOpen
+  meshfree::MeshTopology topology = maybeOpen && boundaryEdges < 0
     ? meshfree::ComputeMeshTopology(result.Mesh.Triangles, result.Mesh.NumberOfPoints())
     : meshfree::MeshTopology();
+  if (boundaryEdges >= 0)
+  {
+    topology.BoundaryEdges = boundaryEdges; // the whole mesh's, counted by the caller (distributed)
+  }
   if (contour.RoundLimitReached || contour.LatticeEdgeReached)
   {
     vtkWarningMacro("The surface may be incomplete ("
@@ -424,20 +462,38 @@ void vtkMeshlessSurface::ReportReconstruction(const Cloud& cloud, const Result& 
     vtkDebugMacro(<< report.RemovedPieces << " of " << report.Pieces << " pieces (" << report.RemovedTriangles
                   << " triangles) removed: fewer than NeighborCount samples support each.");
   }
-  if (result.Mesh.NumberOfTriangles() == 0)
+  if (result.Mesh.NumberOfTriangles() == 0 && result.Report.Contour.ActiveCells == 0)
   {
     vtkWarningMacro("No surface was found in " << valid
                                                << " valid points (too few, or all collinear or coincident).");
   }
 }
 
-void vtkMeshlessSurface::AddApproximatedArrays(const Cloud& cloud, vtkPolyData* output, Result& result, bool reporter)
+void vtkMeshlessSurface::AddApproximatedArrays(
+  const Cloud& cloud, vtkPolyData* output, Result& result, bool reporter, vtkMultiProcessController* controller)
 {
   // Every other numeric point array (Cloud::Arrays, values side by side in Cloud::Values).
   const int columns = cloud.Columns;
   const std::vector<double>& values = cloud.Values;
   const vtkIdType n = cloud.Count;
   const vtkIdType m = result.Mesh.NumberOfPoints();
+  // The range of each component over the whole cloud (distributed: collective, every rank alike).
+  std::vector<double> lows(static_cast<size_t>(columns), std::numeric_limits<double>::infinity());
+  std::vector<double> highs(static_cast<size_t>(columns), -std::numeric_limits<double>::infinity());
+  for (int c = 0; c < columns; ++c)
+  {
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      const double v = values[static_cast<size_t>(i) * columns + c];
+      if (std::isfinite(v))
+      {
+        lows[c] = std::min(lows[c], v);
+        highs[c] = std::max(highs[c], v);
+      }
+    }
+    lows[c] = -vtkMeshFreeHalo::GlobalMax(controller, -lows[c]);
+    highs[c] = vtkMeshFreeHalo::GlobalMax(controller, highs[c]);
+  }
   if (cloud.Arrays.empty() || columns == 0 || m == 0)
   {
     return;
@@ -484,16 +540,7 @@ void vtkMeshlessSurface::AddApproximatedArrays(const Cloud& cloud, vtkPolyData* 
   // surface stays within the kernel radius of its particles, so its values keep the linear extrapolation.
   for (int c = 0; c < columns && this->Method != SPH; ++c)
   {
-    double low = std::numeric_limits<double>::infinity(), high = -low;
-    for (vtkIdType i = 0; i < n; ++i)
-    {
-      const double v = values[static_cast<size_t>(i) * columns + c];
-      if (std::isfinite(v))
-      {
-        low = std::min(low, v);
-        high = std::max(high, v);
-      }
-    }
+    const double low = lows[c], high = highs[c];
     for (vtkIdType i = 0; i < m && low <= high; ++i)
     {
       double& v = results[static_cast<size_t>(i) * columns + c];
@@ -540,6 +587,200 @@ void vtkMeshlessSurface::AddApproximatedArrays(const Cloud& cloud, vtkPolyData* 
   result.ApproximationSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+int vtkMeshlessSurface::ReconstructDistributed(
+  vtkPointSet* input, vtkMultiProcessController* controller, vtkPolyData* output)
+{
+  const int me = controller->GetLocalProcessId();
+  const bool reporter = me == 0;
+  Cloud cloud;
+  Layout layout;
+  this->PrepareInput(input, controller, cloud, layout);
+  const vtkIdType n = input->GetNumberOfPoints();
+  const vtkIdType total = vtkMeshFreeHalo::GlobalSum(controller, n);
+  if (total == 0)
+  {
+    if (reporter)
+    {
+      vtkWarningMacro("The input has no points: no surface.");
+    }
+    return 1;
+  }
+  // This rank's rows as a point cloud (coordinates; the rest of the row as one array), with its global ids.
+  vtkNew<vtkPolyData> piece;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  const int rest = layout.Width - 3;
+  vtkNew<vtkDoubleArray> tail;
+  tail->SetName("MeshFreeRow");
+  tail->SetNumberOfComponents(std::max(rest, 1));
+  tail->SetNumberOfTuples(n);
+  std::vector<double> xyz(3 * static_cast<size_t>(n));
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    const double* row = &layout.Rows[static_cast<size_t>(i) * layout.Width];
+    points->SetPoint(i, row);
+    std::copy_n(row, 3, &xyz[3 * i]);
+    for (int c = 0; c < rest; ++c)
+    {
+      tail->SetComponent(i, c, row[3 + c]);
+    }
+  }
+  std::vector<double>().swap(layout.Rows);
+  piece->SetPoints(points);
+  piece->GetPointData()->AddArray(tail);
+  if (vtkDataArray* ids = input->GetPointData()->GetGlobalIds())
+  {
+    piece->GetPointData()->SetGlobalIds(ids);
+  }
+  vtkIdType invalid = 0;
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    invalid += std::isfinite(xyz[3 * i]) && std::isfinite(xyz[3 * i + 1]) && std::isfinite(xyz[3 * i + 2]) ? 0 : 1;
+  }
+  invalid = vtkMeshFreeHalo::GlobalSum(controller, invalid);
+
+  // Space cut in slabs of equal shares, the points moved to their slab's rank; then a halo around each slab,
+  // widened while the core reports a shortfall (the last attempt takes every point, always enough).
+  const vtkMeshFreeSlabs::Partition slabs = vtkMeshFreeSlabs::Choose(controller, xyz.data(), n);
+  std::vector<double>().swap(xyz);
+  vtkSmartPointer<vtkPolyData> mine = vtkMeshFreeSlabs::Move(controller, piece, slabs);
+  piece->Initialize();
+  double region[6];
+  slabs.Region(me, region);
+  meshfree::SurfaceOptions options = this->Options();
+  options.Framed = true;
+  std::copy(slabs.Bounds, slabs.Bounds + 6, options.FrameBounds);
+  options.FramePoints = slabs.Points;
+  const vtkIdType own = mine->GetNumberOfPoints();
+  const double* ownXyz = own > 0 ? vtkDoubleArray::SafeDownCast(mine->GetPoints()->GetData())->GetPointer(0) : nullptr;
+  const int k = std::max(3, this->NeighborCount);
+  // Normals read about 8 neighbourhood radii; the fits 3 supports (SupportScale neighbourhood radii) and a cell.
+  const double rk = vtkMeshFreeHalo::GlobalMax(controller, vtkMeshFreeHalo::LocalNeighborDistance(ownXyz, own, k));
+  double radius = std::max(8.0, 3.0 * this->SupportScale + 2.0) * rk;
+  if (this->SupportRadius > 0.0)
+  {
+    radius = std::max(radius, (3.0 * this->SupportScale + 2.0) * this->SupportRadius);
+  }
+  vtkNew<vtkMeshFreeHalo> halo;
+  halo->SetController(controller);
+  Result result;
+  int attempts = 0;
+  vtkIdType held = 0;
+  vtkIdType boundaryEdges = 0;
+  for (int attempt = 0; attempt < 4; ++attempt)
+  {
+    if (attempt == 3 || !std::isfinite(radius) || !(radius > 0.0))
+    {
+      radius = std::numeric_limits<double>::infinity();
+    }
+    halo->Exchange(mine, region, radius);
+    attempts = attempt + 1;
+    vtkMeshFreeHaloDistribution processes(controller, halo, region, radius);
+    processes.SetSlab(slabs.Axis, slabs.Lower(me), slabs.Upper(me));
+    vtkPolyData* local = halo->GetOutput();
+    held = local->GetNumberOfPoints();
+    std::vector<double> rows(static_cast<size_t>(held) * layout.Width);
+    vtkDataArray* travelled = local->GetPointData()->GetArray("MeshFreeRow");
+    for (vtkIdType i = 0; i < held; ++i)
+    {
+      double* row = &rows[static_cast<size_t>(i) * layout.Width];
+      local->GetPoint(i, row);
+      for (int c = 0; c < rest; ++c)
+      {
+        row[3 + c] = travelled->GetComponent(i, c);
+      }
+    }
+    UnpackRows(rows.data(), held, layout.Width, layout.UseNormals, layout.UseVolumes, cloud);
+    std::vector<double>().swap(rows);
+    meshfree::SurfaceInput in;
+    in.Points = cloud.Points.data();
+    in.Count = cloud.Count;
+    in.Normals = cloud.Normals.empty() ? nullptr : cloud.Normals.data();
+    options.Processes = &processes;
+    std::string error;
+    const bool done = meshfree::ReconstructSurface(in, options, result.Mesh, result.Report, error,
+      attempt == 0 ? vtkMeshFreeFilterSupport::Progress(this, 0.0, 0.9) : meshfree::ProgressCallback());
+    options.Processes = nullptr;
+    if (vtkMeshFreeHalo::GlobalMax(controller, result.Report.NotDistributed ? 1.0 : 0.0) > 0.0)
+    {
+      vtkDebugMacro("Falling back to the gathered cloud: " << error);
+      return 0; // every rank alike: the caller gathers
+    }
+    if (!done && !result.Report.Aborted)
+    {
+      vtkErrorMacro("Invalid settings: " << error << " The output is empty.");
+      return 1;
+    }
+    if (vtkMeshFreeHalo::GlobalMax(controller, done && !result.Report.Aborted ? 0.0 : 1.0) > 0.0)
+    {
+      vtkWarningMacro("Aborted: the output is empty.");
+      return 1;
+    }
+    const double shortfall = vtkMeshFreeHalo::GlobalMax(controller, result.Report.Shortfall);
+    vtkDebugMacro("Halo radius " << radius << ": " << held << " points held, shortfall " << shortfall << ".");
+    if (!(shortfall > 0.0) || std::isinf(radius))
+    {
+      boundaryEdges = meshfree::BoundaryEdges(result.Mesh, 2.0 * result.Report.CellSize, &processes);
+      break;
+    }
+    radius = std::max(radius + 1.25 * shortfall, 1.5 * radius);
+  }
+
+  // Report the whole cloud's counts (rank 0), wrap this rank's part, approximate the arrays at its vertices.
+  meshfree::SurfaceReport& report = result.Report;
+  report.InvalidPoints = invalid;
+  report.Duplicates = vtkMeshFreeHalo::GlobalSum(controller, report.Duplicates);
+  report.Outliers = vtkMeshFreeHalo::GlobalSum(controller, report.Outliers);
+  report.PointsWithoutNormal = vtkMeshFreeHalo::GlobalSum(controller, report.PointsWithoutNormal);
+  report.TrimmedTriangles = vtkMeshFreeHalo::GlobalSum(controller, report.TrimmedTriangles);
+  report.Contour.ActiveCells = vtkMeshFreeHalo::GlobalSum(controller, report.Contour.ActiveCells);
+  report.Contour.UndefinedCorners = vtkMeshFreeHalo::GlobalSum(controller, report.Contour.UndefinedCorners);
+  const vtkIdType triangles = vtkMeshFreeHalo::GlobalSum(controller, result.Mesh.NumberOfTriangles());
+  if (reporter)
+  {
+    Cloud whole;
+    whole.Count = total;
+    whole.InvalidVolumes = 0;
+    Result summary;
+    summary.Report = report;
+    summary.Report.Contour.ActiveCells = triangles > 0 ? report.Contour.ActiveCells : 0;
+    this->ReportReconstruction(whole, summary, boundaryEdges);
+  }
+  WrapMesh(result.Mesh, output);
+  this->AddApproximatedArrays(cloud, output, result, reporter, controller);
+  if (result.Aborted)
+  {
+    output->Initialize();
+    vtkWarningMacro("Aborted: the output is empty.");
+    return 1;
+  }
+  this->AddFieldData(output, result);
+  vtkFieldData* fd = output->GetFieldData();
+  vtkNew<vtkTypeInt64Array> local;
+  local->SetName("LocalCloudPoints");
+  local->InsertNextValue(held);
+  fd->AddArray(local);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", radius);
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloAttempts", attempts);
+  return 1;
+}
+
+meshfree::SurfaceOptions vtkMeshlessSurface::Options() const
+{
+  meshfree::SurfaceOptions options;
+  options.Method = static_cast<meshfree::SurfaceMethod>(this->Method);
+  options.NeighborCount = this->NeighborCount;
+  options.SupportRadius = this->SupportRadius;
+  options.SupportScale = this->SupportScale;
+  options.CellSize = this->CellSize;
+  options.Level = this->SurfaceLevel;
+  options.Anisotropic = this->AnisotropicKernels;
+  options.ProjectVertices = this->ProjectVertices;
+  options.HoleFilling = static_cast<meshfree::HoleFillingMode>(this->HoleFilling);
+  return options;
+}
+
 int vtkMeshlessSurface::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -559,6 +800,12 @@ int vtkMeshlessSurface::RequestData(
   vtkMultiProcessController* controller = distributed ? vtkMultiProcessController::GetGlobalController() : nullptr;
   const bool reporter = !distributed || controller->GetLocalProcessId() == 0; // one rank warns about the cloud
 
+  // Distributed: each rank its slab of space and a halo (MLS, WLS; HoleFilling and SPH still gather, below).
+  if (distributed && this->Method != SPH && this->ReconstructDistributed(input, controller, output))
+  {
+    return 1;
+  }
+
   // Validate and gather.
   Cloud cloud;
   this->GatherInput(input, controller, cloud);
@@ -577,16 +824,7 @@ int vtkMeshlessSurface::RequestData(
   in.Count = cloud.Count;
   in.Normals = cloud.Normals.empty() ? nullptr : cloud.Normals.data();
   in.Volumes = cloud.Volumes.empty() ? nullptr : cloud.Volumes.data();
-  meshfree::SurfaceOptions options;
-  options.Method = static_cast<meshfree::SurfaceMethod>(this->Method);
-  options.NeighborCount = this->NeighborCount;
-  options.SupportRadius = this->SupportRadius;
-  options.SupportScale = this->SupportScale;
-  options.CellSize = this->CellSize;
-  options.Level = this->SurfaceLevel;
-  options.Anisotropic = this->AnisotropicKernels;
-  options.ProjectVertices = this->ProjectVertices;
-  options.HoleFilling = static_cast<meshfree::HoleFillingMode>(this->HoleFilling);
+  const meshfree::SurfaceOptions options = this->Options();
   Result result;
   std::string error;
   if (!meshfree::ReconstructSurface(in, options, result.Mesh, result.Report, error, vtkMeshFreeFilterSupport::Progress(this, 0.0, 0.9)))
@@ -647,6 +885,13 @@ int vtkMeshlessSurface::RequestData(
     return 1;
   }
 
+  this->AddFieldData(output, result);
+  return 1;
+}
+
+void vtkMeshlessSurface::AddFieldData(vtkPolyData* output, const Result& result)
+{
+  const meshfree::SurfaceOptions options = this->Options();
   vtkFieldData* fd = output->GetFieldData();
   vtkNew<vtkStringArray> method;
   method->SetName("SurfaceMethod");
@@ -663,7 +908,6 @@ int vtkMeshlessSurface::RequestData(
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "ContourSeconds", result.Report.ContourSeconds);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "ProjectionSeconds", result.Report.ProjectionSeconds);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "ApproximationSeconds", result.ApproximationSeconds);
-  return 1;
 }
 
 void vtkMeshlessSurface::PrintSelf(ostream& os, vtkIndent indent)

@@ -4,6 +4,8 @@
 // point within the halo radius of its slab as halo. The union of the pieces' triangles must be the serial run's
 // triangles, vertex for vertex bit for bit, with the same normals and DistanceToData.
 #include "Common/Distribution.h"
+#include "Surface/DataSupport.h"
+#include "Surface/MeshTopology.h"
 #include "Surface/SurfaceReconstruction.h"
 #include "SurfaceSamples.h"
 #include "ThreadProcesses.h"
@@ -134,6 +136,7 @@ struct Runs
   std::vector<SurfaceMesh> Meshes;
   std::vector<SurfaceReport> Reports;
   std::vector<Piece> Pieces;
+  std::vector<Index> BoundaryEdges; // per piece: the whole mesh's (DataSupport.h's BoundaryEdges)
   double Halo = 0.0;
 };
 
@@ -170,6 +173,7 @@ void Distribute(Runs& run, const std::vector<double>& xyz, const SurfaceOptions&
   run.Pieces = SplitSlabs(xyz, size, radius);
   run.Meshes.resize(size);
   run.Reports.resize(size);
+  run.BoundaryEdges.assign(size, -1);
   World world(size);
   double frame[6];
   GlobalBounds(nullptr, xyz.data(), static_cast<Index>(xyz.size() / 3), frame);
@@ -192,6 +196,7 @@ void Distribute(Runs& run, const std::vector<double>& xyz, const SurfaceOptions&
       const Piece& p = run.Pieces[r];
       ReconstructSurface(SurfaceInput{ p.Points.data(), static_cast<Index>(p.Points.size() / 3) }, mine,
         run.Meshes[r], run.Reports[r], errors[r]);
+      run.BoundaryEdges[r] = BoundaryEdges(run.Meshes[r], 2.0 * run.Reports[r].CellSize, &processes);
     });
   }
   for (std::thread& t : threads)
@@ -228,6 +233,7 @@ void ExpectSameAsSerial(const Runs& run, bool partial = true)
     EXPECT_EQ(run.Reports[r].SupportRadius, run.SerialReport.SupportRadius);
     EXPECT_EQ(run.Reports[r].Pieces, run.SerialReport.Pieces);
     EXPECT_EQ(run.Reports[r].RemovedPieces, run.SerialReport.RemovedPieces);
+    EXPECT_EQ(run.BoundaryEdges[r], ComputeMeshTopology(run.Serial.Triangles, run.Serial.NumberOfPoints()).BoundaryEdges);
     const std::vector<std::array<Vertex, 3>> mine = Triangles(mesh);
     together.insert(together.end(), mine.begin(), mine.end());
     for (Index v = 0; v < mesh.NumberOfPoints(); ++v)

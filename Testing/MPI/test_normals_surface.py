@@ -15,7 +15,10 @@ ranks, --reference) with an independent `pvpython --no-mpi` run:
   bit for bit.
 Bitwise: Meshless Normals computes each rank's own points over its piece and a halo with the whole cloud's
 neighbour-grid frame, exact medians and halo updates of the neighbours' values (see vtkMeshlessNormals.h); Meshless
-Surface runs the serial algorithm on the gathered cloud. Also a one-point cloud (no hang, no output).
+Surface with HoleFilling Off does the same over slabs of space and contours each slab's lattice cells (the cases
+marked distributed: also held shares, split by index, unevenly, in slabs, permuted, redistributed, with NaN points,
+all on one rank); with holes filled it runs the serial algorithm on the gathered cloud. Also a one-point cloud (no
+hang, no output).
 --measure: print the differences without failing (how far the pieces are from serial).
 """
 import builtins
@@ -90,7 +93,7 @@ from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
 self.GetOutputInformation(0).Set(vtkAlgorithm.CAN_HANDLE_PIECE_REQUEST(), 1)
 """
 NORMAL_ARRAYS = ["Normals", "Curvature", "SurfaceVariation", "OrientationConfidence", "vtkValidPointMask"]
-SURFACE_ARRAYS = ["Normals", "Temperature", "vtkValidPointMask"]
+SURFACE_ARRAYS = ["Normals", "DistanceToData", "Temperature", "vtkValidPointMask"]
 
 
 def cloud(count, split, shuffle=0, nans=0):
@@ -173,31 +176,39 @@ def normals_case(label, count, split, max_share=1.0, shuffle=0, nans=0, **settin
         array = local.GetFieldData().GetArray(name)
         mm.check(array is not None, f"field {name} missing on rank {mm.RANK}")
         agree(array.GetTuple1(0), f"Normals {label} ({split} split): field {name}")
-    # Distributed, not gathered: each rank computes over its piece and a halo (LocalCloudPoints), never more than
-    # the cloud; slabs of a large enough cloud hold well under the whole of it.
     if mm.RANKS == 1:
         return normals
+    held_share(local, f"Normals {label}", split, count, max_share)
+    return normals
+
+
+def held_share(local, label, split, count, max_share):
+    """Distributed, not gathered: each rank computes over its piece (Normals) or slab (Surface) and a halo
+    (LocalCloudPoints), never more than the cloud; slabs of a large enough cloud hold well under the whole of it."""
     held = local.GetFieldData().GetArray("LocalCloudPoints")
-    mm.check(held is not None and held.GetTuple1(0) <= count, f"Normals {label}: LocalCloudPoints missing or > {count}")
+    mm.check(held is not None and held.GetTuple1(0) <= count, f"{label}: LocalCloudPoints missing or > {count}")
     if split in ("slab", "redistribute"):
         most = mm.all_gather(np.array([[held.GetTuple1(0)]]))[:, 0].max()
         radius = local.GetFieldData().GetArray("HaloRadius").GetTuple1(0)
         attempts = local.GetFieldData().GetArray("HaloAttempts").GetTuple1(0)
         if mm.RANK == 0:
-            mm.log(f"Normals {label} ({split}): at most {int(most)} of {count} points on a rank "
+            mm.log(f"{label} ({split}): at most {int(most)} of {count} points on a rank "
                    f"(halo radius {radius:.3g}, {int(attempts)} attempt(s))")
-        mm.check(most <= max_share * count, f"Normals {label} ({split}): a rank held {most} of {count} points")
-    return normals
+        mm.check(most <= max_share * count, f"{label} ({split}): a rank held {most} of {count} points")
 
 
-def surface_case(label, count, split, with_normals=False, **settings):
-    source = cloud(count, split)
+def surface_case(label, count, split, with_normals=False, max_share=1.0, shuffle=0, nans=0, distributed=False,
+                 **settings):
+    # With shuffle, the pieces hold a permutation of the cloud; the serial run is of the cloud in its own order.
+    source = cloud(count, split, shuffle, nans)
+    pieces = simple.RedistributeDataSet(Input=source) if split == "redistribute" else source
 
-    def make():
-        upstream = MeshlessNormals(Input=source) if with_normals else source
+    def make(upstream):
+        upstream = MeshlessNormals(Input=upstream) if with_normals else upstream
         return MeshlessSurface(Input=upstream, **settings)
 
-    surface, serial = make(), make()
+    surface = make(pieces)
+    serial = make(cloud(count, split, 0, nans) if shuffle else source)
     local = mm.local_output(surface, 0.0)
     got = mm.all_gather(soup(local, SURFACE_ARRAYS))
     got = got[np.lexsort(got.T[::-1])] if len(got) else got
@@ -209,6 +220,8 @@ def surface_case(label, count, split, with_normals=False, **settings):
         mm.reference(f"surface_{label}", got)
     cell = local.GetFieldData().GetArray("CellSize")
     agree(cell.GetTuple1(0) if cell else float("nan"), f"Surface {label} ({split} split): field CellSize")
+    if distributed and mm.RANKS > 1:
+        held_share(local, f"Surface {label}", split, count, max_share)
 
 
 for piece_split in ("even", "uneven"):
@@ -236,6 +249,19 @@ normals_case("with_nan", 3000, "even", nans=7)
 normals_case("fixed_radius", 3000, "slab", SupportRadius=0.15)
 # Every point on one rank, the others empty.
 normals_case("all_on_last_rank", 3000, "last")
+
+# The surface distributed (HoleFilling Off; filling holes still gathers the cloud): each rank contours its slab of
+# space over its slab's points and a halo; the ranks' triangles are the serial ones, bit for bit.
+OPEN = dict(HoleFilling="Off", distributed=True)
+for piece_split in ("even", "uneven"):
+    surface_case("mls_open", 3000, piece_split, **OPEN)
+    surface_case("wls_open_input_normals", 3000, piece_split, with_normals=True, Method="WLS", **OPEN)
+surface_case("open_slabs", 40000, "slab", max_share=0.7 if mm.RANKS == 2 else 0.8, **OPEN)
+for seed in (1, 2, 3):
+    surface_case(f"open_shuffled_{seed}", 3000, "even" if seed < 3 else "slab", shuffle=seed, **OPEN)
+surface_case("open_redistributed", 20000, "redistribute", max_share=0.8 if mm.RANKS == 2 else 0.9, **OPEN)
+surface_case("open_with_nan", 3000, "even", nans=7, **OPEN)
+surface_case("open_all_on_last_rank", 3000, "last", **OPEN)
 
 # One point: no hang, nothing computed, the point on exactly one rank.
 normals_case("one_point", 1, "even")

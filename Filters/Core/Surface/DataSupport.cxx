@@ -440,4 +440,73 @@ std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const Neigh
   return keep;
 }
 
+Index BoundaryEdges(const TriangleMesh& mesh, double band, const Distribution* d)
+{
+  std::vector<std::pair<Index, Index>> edges;
+  edges.reserve(mesh.Triangles.size());
+  for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      const Index a = mesh.Triangles[3 * t + c], b = mesh.Triangles[3 * t + (c + 1) % 3];
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  Index inner = 0;
+  std::vector<double> seam; // per edge near another region: its two end points, the smaller first
+  for (size_t e = 0; e < edges.size();)
+  {
+    size_t f = e;
+    while (f < edges.size() && edges[f] == edges[e])
+    {
+      ++f;
+    }
+    if (f - e == 1)
+    {
+      const double* p = &mesh.Points[3 * edges[e].first];
+      const double* q = &mesh.Points[3 * edges[e].second];
+      const double middle[3] = { 0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2]) };
+      if (!d || d->OwnsBall(middle, band))
+      {
+        ++inner;
+      }
+      else
+      {
+        const bool swap = PositionBefore(q, p);
+        seam.insert(seam.end(), swap ? q : p, (swap ? q : p) + 3);
+        seam.insert(seam.end(), swap ? p : q, (swap ? p : q) + 3);
+      }
+    }
+    e = f;
+  }
+  if (!d)
+  {
+    return inner;
+  }
+  std::vector<double> all;
+  d->Gather(seam, all);
+  const size_t n = all.size() / 6;
+  std::vector<size_t> order(n);
+  for (size_t k = 0; k < n; ++k)
+  {
+    order[k] = k;
+  }
+  std::sort(order.begin(), order.end(), [&all](size_t a, size_t b) {
+    return std::lexicographical_compare(&all[6 * a], &all[6 * a] + 6, &all[6 * b], &all[6 * b] + 6);
+  });
+  Index unmatched = 0;
+  for (size_t k = 0; k < n;)
+  {
+    size_t m = k;
+    while (m < n && std::equal(&all[6 * order[k]], &all[6 * order[k]] + 6, &all[6 * order[m]]))
+    {
+      ++m;
+    }
+    unmatched += (m - k) == 1 ? 1 : 0;
+    k = m;
+  }
+  return GlobalSum(d, inner) + unmatched;
+}
+
 } // namespace meshfree

@@ -66,6 +66,12 @@ std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const Neigh
   const std::vector<double>& sampleLimit, Index minimumSamples, Index& pieces, Index& removedPieces,
   const Distribution* d = nullptr);
 
+/// Boundary edges (of one triangle) of the whole mesh. Distributed (d; collective): `mesh` is a process' part
+/// (SparseContour.h); an edge on the seam between two parts is a boundary edge of both and of neither in the
+/// whole: the parts' boundary edges within `band` (a lattice cell or more) of another process' region are gathered
+/// and those found on two processes cancel. Every process gets the whole mesh's count.
+Index BoundaryEdges(const TriangleMesh& mesh, double band, const Distribution* d = nullptr);
+
 } // namespace meshfree
 
 #endif
