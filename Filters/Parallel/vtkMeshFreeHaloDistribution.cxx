@@ -46,12 +46,16 @@ vtkMeshFreeHaloDistribution::vtkMeshFreeHaloDistribution(vtkMultiProcessControll
 
 double vtkMeshFreeHaloDistribution::Complete(const double x[3]) const
 {
-  double depth = HUGE_VAL;
+  // The radius plus x's depth inside the region, minus its distance to the region when outside.
+  double depth = HUGE_VAL, outside = 0.0;
   for (int a = 0; a < 3; ++a)
   {
-    depth = std::min(depth, std::min(x[a] - this->Region[2 * a], this->Region[2 * a + 1] - x[a]));
+    const double below = this->Region[2 * a] - x[a], above = x[a] - this->Region[2 * a + 1];
+    depth = std::min(depth, -std::max(below, above));
+    const double gap = std::max(0.0, std::max(below, above));
+    outside += gap * gap;
   }
-  return this->Radius + std::max(depth, 0.0);
+  return this->Radius + (outside > 0.0 ? -std::sqrt(outside) : std::max(depth, 0.0));
 }
 
 void vtkMeshFreeHaloDistribution::Sum(double* values, meshfree::Index count) const

@@ -7,7 +7,7 @@
  * The local cloud is the halo's output: the rank's own points first, then the halo. Owned(i): i is one of the
  * first GetNumberOfOwnedPoints(); Key(i): the global point id; UpdateHalo: vtkMeshFreeHalo::UpdateHalo; sums,
  * maxima and gathers: the controller's AllReduce and AllGatherV; Complete(x): the halo's radius plus x's depth
- * inside the region the halo was grown from. Every method but Owned, Key and Complete is collective.
+ * inside the region the halo was grown from (less its distance outside). Every method but Owned, Key and Complete is collective.
  */
 #ifndef vtkMeshFreeHaloDistribution_h
 #define vtkMeshFreeHaloDistribution_h
@@ -40,7 +40,7 @@ public:
   void Max(double* values, meshfree::Index count) const override;
   void Gather(const std::vector<double>& mine, std::vector<double>& all) const override;
   void UpdateHalo(double* values, int components) const override;
-  /// The radius plus x's distance to the border of the region (0 outside it).
+  /// The radius plus x's depth inside the region (minus its distance to the region outside it).
   double Complete(const double x[3]) const override;
 
   /// Space partitioned in slabs along `axis` (vtkMeshFreeSlabs): this rank owns the positions with lower <=

@@ -800,7 +800,7 @@ int vtkMeshlessSurface::RequestData(
   vtkMultiProcessController* controller = distributed ? vtkMultiProcessController::GetGlobalController() : nullptr;
   const bool reporter = !distributed || controller->GetLocalProcessId() == 0; // one rank warns about the cloud
 
-  // Distributed: each rank its slab of space and a halo (MLS, WLS; HoleFilling and SPH still gather, below).
+  // Distributed: each rank its slab of space and a halo (MLS, WLS; SPH still gathers, below).
   if (distributed && this->Method != SPH && this->ReconstructDistributed(input, controller, output))
   {
     return 1;

@@ -39,21 +39,21 @@
  * Under MPI (pvbatch, pvserver: each rank's input is piece = rank of N) the pieces' outputs together are the
  * serial surface, each triangle on exactly one rank, with the serial vertex positions, Normals, DistanceToData and
  * approximated arrays bit for bit.
- * - MLS and WLS with HoleFilling Off, or Auto on an open cloud, are distributed: space is cut in one slab per rank
- *   along the cloud's longest axis at the quantiles of its points (exact distributed selections), every point moves
- *   to its slab's rank, and each rank brings in a halo (every point within a radius of its slab, vtkMeshFreeHalo:
- *   first 8 neighbourhood radii, widened and recomputed when the core reports that a computation reached beyond
- *   it). Each rank estimates its own points' normals and fits (whole-cloud statistics by reductions, the
- *   orientation across slabs as Meshless Normals does) and contours the lattice cells whose centre lies in its
- *   slab; the contouring hands the cells beyond the slab to their rank round by round, so the ranks' parts are the
- *   serial surface's and meet without cracks (a vertex on a seam is on both ranks). Stray pieces are judged on the
- *   whole mesh (pieces joined across the seams). A rank holds its slab and a band of halo, never the whole cloud
- *   unless the halo needs it (field data `LocalCloudPoints`, `HaloRadius`, `HaloAttempts`, per rank). Each rank's
- *   output is its slab's part (not the ParaView piece it was given).
- * - Holes filled (HoleFilling On, or Auto on a closed cloud: the winding number sums over every point) and SPH still
- *   gather: every rank gathers the whole cloud (coordinates, input Normals, SPH volumes and the arrays to
- *   approximate), puts it in global id order (GlobalIds, else the rank-by-rank concatenation), runs the serial
- *   reconstruction and keeps triangles [T r / N, T (r + 1) / N) of its T with the vertices they use.
+ * - MLS and WLS are distributed: space is cut in one slab per rank along the cloud's longest axis at the quantiles
+ *   of its points (exact distributed selections), every point moves to its slab's rank, and each rank brings in a
+ *   halo (every point within a radius of its slab, vtkMeshFreeHalo: first 8 neighbourhood radii, widened and
+ *   recomputed when the core reports that a computation reached beyond it). Each rank estimates its own points'
+ *   normals and fits (whole-cloud statistics by reductions, the orientation across slabs as Meshless Normals
+ *   does) and contours the lattice cells whose centre lies in its slab; the contouring hands the cells beyond the
+ *   slab to their rank round by round, so the ranks' parts are the serial surface's and meet without cracks (a
+ *   vertex on a seam is on both ranks). HoleFilling's winding number sums over every point: each rank sums the
+ *   cubes near it from its halo and the others by their moments, gathered from their owners (WindingNumber.h).
+ *   Stray pieces are judged on the whole mesh (pieces joined across the seams). A rank holds its slab and a band of
+ *   halo, never the whole cloud unless the halo needs it (field data `LocalCloudPoints`, `HaloRadius`,
+ *   `HaloAttempts`, per rank). Each rank's output is its slab's part (not the ParaView piece it was given).
+ * - SPH still gathers: every rank gathers the whole cloud (coordinates, volumes and the arrays to approximate),
+ *   puts it in global id order (GlobalIds, else the rank-by-rank concatenation), runs the serial reconstruction and
+ *   keeps triangles [T r / N, T (r + 1) / N) of its T with the vertices they use.
  * A point array is approximated when every rank with points has it (same name, components); otherwise none is,
  * with a warning. An input that every rank holds whole (piece 0 of 1 on each rank) is reconstructed locally,
  * whole, without communication.

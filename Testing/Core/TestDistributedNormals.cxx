@@ -101,14 +101,8 @@ double RunDistributed(const std::vector<double>& xyz, int size, double radius, c
   pieces = Split(xyz, size, radius);
   results.assign(size, CloudNormalsResult());
   World world(size);
-  // The whole cloud's frame: the bounds and number of its finite points (as the VTK layer reduces them).
   double frame[6];
-  GlobalBounds(nullptr, xyz.data(), static_cast<Index>(xyz.size() / 3), frame);
-  Index finite = 0;
-  for (size_t i = 0; i < xyz.size(); i += 3)
-  {
-    finite += std::isfinite(xyz[i]) && std::isfinite(xyz[i + 1]) && std::isfinite(xyz[i + 2]) ? 1 : 0;
-  }
+  const Index finite = WholeFrame(xyz, frame);
   std::vector<std::thread> threads;
   for (int r = 0; r < size; ++r)
   {

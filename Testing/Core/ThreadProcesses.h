@@ -74,7 +74,8 @@ struct Piece
   Index OwnCount = 0;
   double Region[6];
   double Radius = 0.0;
-  // Positions owned (slab partitions): Lower <= x < Upper (the whole space by default).
+  // Positions owned (slab partitions): Lower <= x[Axis] < Upper (the whole space by default).
+  int Axis = 0;
   double Lower = -HUGE_VAL;
   double Upper = HUGE_VAL;
 };
@@ -144,23 +145,27 @@ public:
   }
   double Complete(const double x[3]) const override
   {
+    // The radius plus x's depth inside the region, minus its distance to the region when outside.
     const Piece& p = this->Pieces[this->Me];
-    double depth = HUGE_VAL;
+    double depth = HUGE_VAL, outside = 0.0;
     for (int a = 0; a < 3; ++a)
     {
-      depth = std::min(depth, std::min(x[a] - p.Region[2 * a], p.Region[2 * a + 1] - x[a]));
+      const double below = p.Region[2 * a] - x[a], above = x[a] - p.Region[2 * a + 1];
+      depth = std::min(depth, -std::max(below, above));
+      const double gap = std::max(0.0, std::max(below, above));
+      outside += gap * gap;
     }
-    return p.Radius + std::max(depth, 0.0);
+    return p.Radius + (outside > 0.0 ? -std::sqrt(outside) : std::max(depth, 0.0));
   }
   bool OwnsPosition(const double x[3]) const override
   {
     const Piece& p = this->Pieces[this->Me];
-    return p.Lower <= x[0] && x[0] < p.Upper;
+    return p.Lower <= x[p.Axis] && x[p.Axis] < p.Upper;
   }
   bool OwnsBall(const double x[3], double radius) const override
   {
     const Piece& p = this->Pieces[this->Me];
-    return p.Lower <= x[0] - radius && x[0] + radius < p.Upper;
+    return p.Lower <= x[p.Axis] - radius && x[p.Axis] + radius < p.Upper;
   }
 
 private:
@@ -184,6 +189,18 @@ private:
   int Me;
   const std::vector<Piece>& Pieces;
 };
+
+/// The whole cloud's frame as the VTK layer reduces it: the bounds of its finite points and their number.
+inline Index WholeFrame(const std::vector<double>& xyz, double frame[6])
+{
+  GlobalBounds(nullptr, xyz.data(), static_cast<Index>(xyz.size() / 3), frame);
+  Index finite = 0;
+  for (size_t i = 0; i < xyz.size(); i += 3)
+  {
+    finite += std::isfinite(xyz[i]) && std::isfinite(xyz[i + 1]) && std::isfinite(xyz[i + 2]) ? 1 : 0;
+  }
+  return finite;
+}
 
 } // namespace testing
 } // namespace meshfree

@@ -15,10 +15,10 @@ ranks, --reference) with an independent `pvpython --no-mpi` run:
   bit for bit.
 Bitwise: Meshless Normals computes each rank's own points over its piece and a halo with the whole cloud's
 neighbour-grid frame, exact medians and halo updates of the neighbours' values (see vtkMeshlessNormals.h); Meshless
-Surface with HoleFilling Off does the same over slabs of space and contours each slab's lattice cells (the cases
-marked distributed: also held shares, split by index, unevenly, in slabs, permuted, redistributed, with NaN points,
-all on one rank); with holes filled it runs the serial algorithm on the gathered cloud. Also a one-point cloud (no
-hang, no output).
+Surface (MLS, WLS) does the same over slabs of space and contours each slab's lattice cells, its winding number
+summing the far slabs' cubes by their gathered moments (the cases split by index, unevenly, in slabs - held shares
+asserted -, permuted, redistributed, with NaN points, all on one rank; holes filled and not). Also a one-point cloud
+(no hang, no output).
 --measure: print the differences without failing (how far the pieces are from serial).
 """
 import builtins
@@ -228,8 +228,8 @@ for piece_split in ("even", "uneven"):
     normals_case("auto", 3000, piece_split)
     normals_case("viewpoint_projected", 3000, piece_split, Orientation="Viewpoint", Viewpoint=[0.0, 0.0, 3.0],
                  ProjectPoints=1)
-    surface_case("mls", 3000, piece_split)
-    surface_case("wls_input_normals", 3000, piece_split, with_normals=True, Method="WLS")
+    surface_case("mls", 3000, piece_split, distributed=True)
+    surface_case("wls_input_normals", 3000, piece_split, with_normals=True, Method="WLS", distributed=True)
 
 # Slabs of a larger cloud: the same bits, and each rank holds its slab and a band of halo only. The band is about
 # 8 neighbourhood radii (0.41) each side: on 2 ranks a slab and its band are 65 % of this torus (x in [-1.4, 1.4]),
@@ -250,18 +250,21 @@ normals_case("fixed_radius", 3000, "slab", SupportRadius=0.15)
 # Every point on one rank, the others empty.
 normals_case("all_on_last_rank", 3000, "last")
 
-# The surface distributed (HoleFilling Off; filling holes still gathers the cloud): each rank contours its slab of
-# space over its slab's points and a halo; the ranks' triangles are the serial ones, bit for bit.
-OPEN = dict(HoleFilling="Off", distributed=True)
+# The surface distributed: each rank contours its slab of space over its slab's points and a halo; the ranks'
+# triangles are the serial ones, bit for bit. The torus encloses a volume: by default (Auto) its holes are filled
+# (the winding number over the whole cloud); Off keeps the fits alone and trims to the data.
 for piece_split in ("even", "uneven"):
-    surface_case("mls_open", 3000, piece_split, **OPEN)
-    surface_case("wls_open_input_normals", 3000, piece_split, with_normals=True, Method="WLS", **OPEN)
-surface_case("open_slabs", 40000, "slab", max_share=0.7 if mm.RANKS == 2 else 0.8, **OPEN)
+    surface_case("mls_open", 3000, piece_split, HoleFilling="Off", distributed=True)
+    surface_case("wls_open_input_normals", 3000, piece_split, with_normals=True, Method="WLS", HoleFilling="Off",
+                 distributed=True)
+surface_case("filled_slabs", 40000, "slab", max_share=0.7 if mm.RANKS == 2 else 0.8, distributed=True)
+surface_case("open_slabs", 40000, "slab", max_share=0.7 if mm.RANKS == 2 else 0.8, HoleFilling="Off",
+             distributed=True)
 for seed in (1, 2, 3):
-    surface_case(f"open_shuffled_{seed}", 3000, "even" if seed < 3 else "slab", shuffle=seed, **OPEN)
-surface_case("open_redistributed", 20000, "redistribute", max_share=0.8 if mm.RANKS == 2 else 0.9, **OPEN)
-surface_case("open_with_nan", 3000, "even", nans=7, **OPEN)
-surface_case("open_all_on_last_rank", 3000, "last", **OPEN)
+    surface_case(f"shuffled_{seed}", 3000, "even" if seed < 3 else "slab", shuffle=seed, distributed=True)
+surface_case("redistributed", 20000, "redistribute", max_share=0.8 if mm.RANKS == 2 else 0.9, distributed=True)
+surface_case("with_nan", 3000, "even", nans=7, HoleFilling="Off", distributed=True)
+surface_case("all_on_last_rank", 3000, "last", distributed=True)
 
 # One point: no hang, nothing computed, the point on exactly one rank.
 normals_case("one_point", 1, "even")

@@ -43,8 +43,9 @@ public:
   virtual void Gather(const std::vector<double>& mine, std::vector<double>& all) const = 0;
   /// The halo points' `components` values (interleaved, one tuple per local point) replaced by their owners'.
   virtual void UpdateHalo(double* values, int components) const = 0;
-  /// How far around x (an own point) the local cloud is complete: every point of the whole cloud within this
-  /// distance of x is in it (the halo's radius plus x's distance to the border of the region it was grown from).
+  /// How far around x the local cloud is complete: every point of the whole cloud within this distance of x is in
+  /// it (the halo's radius plus x's depth inside the region it was grown from, minus x's distance to that region
+  /// when x lies outside it; negative: nothing is known to be complete around x).
   virtual double Complete(const double x[3]) const = 0;
   /// Computations that partition space rather than points (the surface's contouring lattice: each cell is
   /// contoured by the process owning its centre) ask which process owns a position: every position of space by

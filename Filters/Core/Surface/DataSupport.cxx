@@ -254,6 +254,21 @@ bool PositionBefore(const double* a, const double* b)
 {
   return std::lexicographical_compare(a, a + 3, b, b + 3);
 }
+
+/// The records of `stride` values each in `all`, ordered by their first `key` values (lexicographically; ties in
+/// their order in `all`).
+std::vector<size_t> RecordOrder(const std::vector<double>& all, size_t stride, size_t key)
+{
+  std::vector<size_t> order(all.size() / stride);
+  for (size_t k = 0; k < order.size(); ++k)
+  {
+    order[k] = k;
+  }
+  std::stable_sort(order.begin(), order.end(), [&all, stride, key](size_t a, size_t b) {
+    return std::lexicographical_compare(&all[stride * a], &all[stride * a] + key, &all[stride * b], &all[stride * b] + key);
+  });
+  return order;
+}
 } // namespace
 
 std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const NeighborGrid& grid,
@@ -327,14 +342,7 @@ std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const Neigh
     d->Gather(border, all);
     const size_t nb = all.size() / 4;
     // Pieces joined through the seams: the same point on two processes.
-    std::vector<size_t> byPosition(nb);
-    for (size_t b = 0; b < nb; ++b)
-    {
-      byPosition[b] = b;
-    }
-    std::sort(byPosition.begin(), byPosition.end(), [&all](size_t a, size_t b) {
-      return PositionBefore(&all[4 * a], &all[4 * b]) || (std::equal(&all[4 * a], &all[4 * a] + 3, &all[4 * b]) && a < b);
-    });
+    const std::vector<size_t> byPosition = RecordOrder(all, 4, 3);
     Union joined(nodes);
     for (size_t k = 1; k < nb; ++k)
     {
@@ -487,14 +495,7 @@ Index BoundaryEdges(const TriangleMesh& mesh, double band, const Distribution* d
   std::vector<double> all;
   d->Gather(seam, all);
   const size_t n = all.size() / 6;
-  std::vector<size_t> order(n);
-  for (size_t k = 0; k < n; ++k)
-  {
-    order[k] = k;
-  }
-  std::sort(order.begin(), order.end(), [&all](size_t a, size_t b) {
-    return std::lexicographical_compare(&all[6 * a], &all[6 * a] + 6, &all[6 * b], &all[6 * b] + 6);
-  });
+  const std::vector<size_t> order = RecordOrder(all, 6, 6);
   Index unmatched = 0;
   for (size_t k = 0; k < n;)
   {

@@ -47,12 +47,44 @@ void FilledField::Set(const ImplicitField& fit, const NeighborGrid& grid, const 
   // |grad w| of a closed surface's 1/2 level is about 1 / (its size); far from the data it decays as
   // 1 / distance^3: the floor keeps f_w finite there (its sign is what matters).
   this->GradientFloor = diagonal > 0.0 ? 1e-3 / diagonal : 1.0;
+  // The winding number's cube lattice: edges of one median support from the cloud's corner (the same for every
+  // process: a cube is opened within 2 radii of its centre, so the points an evaluation reads lie within 3 x 0.87
+  // supports, no farther than the fits' 3); distributed, its tree is built now (collectively), serially on first use.
+  this->Cubes = WindingCubes();
+  if (this->InverseScale > 0.0)
+  {
+    this->Cubes.Size = 1.0 / this->InverseScale;
+    // Room for the cloud in the lattice's 2^21 cubes per axis.
+    const double extent = std::max(b[1] - b[0], std::max(b[3] - b[2], b[5] - b[4]));
+    this->Cubes.Size = std::max(this->Cubes.Size, extent / 1048576.0);
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Cubes.Origin[a] = b[2 * a];
+    }
+  }
+  this->Cubes.Processes = d;
+  if (d)
+  {
+    this->Winding();
+  }
+}
+
+double FilledField::Shortfall() const
+{
+  if (!this->Built.load() || !this->Cubes.Processes)
+  {
+    return -HUGE_VAL;
+  }
+  // A cube opened that this process does not hold: the halo needs the cubes' reach more (opened within Beta = 2
+  // radii of their centre, their points a radius farther).
+  const double incomplete = this->Tree.Incomplete() ? 1.5 * std::sqrt(3.0) * this->Cubes.Size : -HUGE_VAL;
+  return std::max(this->Tree.Shortfall(), incomplete);
 }
 
 const WindingNumber& FilledField::Winding() const
 {
   std::call_once(this->Once, [this]() {
-    this->Tree.Build(this->Points, this->Normals, this->Areas, this->Count);
+    this->Tree.Build(this->Points, this->Normals, this->Areas, this->Count, this->Cubes);
     this->Built = true;
   });
   return this->Tree;

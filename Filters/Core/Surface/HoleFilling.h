@@ -47,6 +47,9 @@ public:
   /// The winding number (built on first use; thread-safe).
   const WindingNumber& Winding() const;
   bool WindingBuilt() const { return this->Built.load(); }
+  /// Distributed (Set with d): how far the halo fell short of what the winding number needed (<= 0: complete;
+  /// -infinity serially). Read after the evaluations.
+  double Shortfall() const;
 
   bool Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& scratch) const override;
 
@@ -69,6 +72,7 @@ private:
   Index Count = 0;
   const NeighborGrid* Grid = nullptr;
   double InverseScale = 0.0; // 1 / the median support
+  WindingCubes Cubes;
   double GradientFloor = 0.0;
 };
 

@@ -357,6 +357,7 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   const Distribution* processes = options.Processes;
   if (processes && options.Method == SurfaceMethod::SPH)
   {
+    report.NotDistributed = true;
     error = "The SPH surface is not distributed yet.";
     return false;
   }
@@ -523,13 +524,6 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     report.OpenShare = OpenShare(grid, areas, normals.Normals, d);
     report.HolesFilled = options.HoleFilling == HoleFillingMode::On ||
       (options.HoleFilling == HoleFillingMode::Auto && report.OpenShare < options.ClosedBelow);
-    if (report.HolesFilled && processes)
-    {
-      // The winding number sums over the whole cloud: not distributed yet (every process takes this decision).
-      report.NotDistributed = true;
-      error = "Filling holes needs the whole cloud on every process (HoleFilling is not distributed yet).";
-      return false;
-    }
     if (report.HolesFilled)
     {
       auto filled = std::make_unique<FilledField>();
@@ -573,6 +567,11 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
     {
       report.Shortfall = std::max(report.Shortfall, Shortfall(d, &mesh.Points[3 * v], reach));
+    }
+    if (report.HolesFilled)
+    {
+      // (Only known after every evaluation of the contouring and the projection: checked again below.)
+      report.Shortfall = std::max(report.Shortfall, static_cast<const FilledField&>(*field).Shortfall());
     }
   }
   start = Clock::now();
@@ -619,6 +618,10 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     }
   }
   report.ProjectionSeconds = seconds(start);
+  if (d && report.HolesFilled)
+  {
+    report.Shortfall = std::max(report.Shortfall, static_cast<const FilledField&>(*field).Shortfall());
+  }
   if (progress && !progress(1.0))
   {
     report.Aborted = true;

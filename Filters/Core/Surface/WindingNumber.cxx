@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <utility>
 
 namespace meshfree
 {
@@ -16,14 +18,63 @@ constexpr Index kLeafSize = 32; // a node holds 44 doubles: bigger leaves keep t
 
 void WindingNumber::Build(const double* points, const double* normals, const double* areas, Index count, double beta)
 {
+  this->Build(points, normals, areas, count, WindingCubes(), beta);
+}
+
+namespace
+{
+constexpr Index kCubeCoordinates = Index(1) << 21;
+constexpr int kRecord = 2 + 44; // a gathered cube root: its key (two halves) and its node's 44 doubles
+
+std::uint64_t CubeKey(const double* p, const WindingCubes& cubes)
+{
+  if (!(cubes.Size > 0.0))
+  {
+    return 0;
+  }
+  std::uint64_t key = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    const double t = std::floor((p[a] - cubes.Origin[a]) / cubes.Size);
+    const Index c = static_cast<Index>(std::min(std::max(t, 0.0), static_cast<double>(kCubeCoordinates - 1)));
+    key |= static_cast<std::uint64_t>(c) << (21 * a);
+  }
+  return key;
+}
+
+void CubeCentre(std::uint64_t key, const WindingCubes& cubes, double centre[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    const Index c = static_cast<Index>((key >> (21 * a)) & (kCubeCoordinates - 1));
+    centre[a] = cubes.Origin[a] + (static_cast<double>(c) + 0.5) * cubes.Size;
+  }
+}
+} // namespace
+
+void WindingNumber::Build(const double* points, const double* normals, const double* areas, Index count,
+  const WindingCubes& cubes, double beta)
+{
+  const Distribution* d = cubes.Processes;
   this->Nodes.clear();
   this->Points.clear();
   this->Normals.clear();
   this->Areas.clear();
   this->Soft2.clear();
   this->Total = 0.0;
+  this->Root = 0;
+  this->BuildShortfall = -HUGE_VAL;
+  this->Opened = false;
   this->Beta2 = std::max(1.0, beta) * std::max(1.0, beta);
-  std::vector<Index> order;
+  const bool lattice = cubes.Size > 0.0 && std::isfinite(cubes.Size);
+  const double halfDiagonal = lattice ? 0.5 * std::sqrt(3.0) * cubes.Size : HUGE_VAL;
+  // The valid points with their cube, sorted by cube (then by position, as the trees order them).
+  struct Keyed
+  {
+    std::uint64_t Key;
+    Item It;
+  };
+  std::vector<Keyed> keyed;
   for (Index i = 0; i < count; ++i)
   {
     const double* p = points + 3 * i;
@@ -32,35 +83,67 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     if (std::isfinite(p[0] + p[1] + p[2]) && len > 0.0 && std::isfinite(len) && areas[i] > 0.0 &&
       std::isfinite(areas[i]))
     {
-      order.push_back(i);
+      keyed.push_back(Keyed{ lattice ? CubeKey(p, cubes) : 0, Item{ { p[0], p[1], p[2] }, i } });
     }
   }
-  if (order.empty())
+  std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+    return a.Key < b.Key ||
+      (a.Key == b.Key &&
+        (std::lexicographical_compare(a.It.P, a.It.P + 3, b.It.P, b.It.P + 3) ||
+          (std::equal(a.It.P, a.It.P + 3, b.It.P) && a.It.Id < b.It.Id)));
+  });
+  // The cubes this process holds completely (all of them when serial): their points, in cube order.
+  std::vector<Item> items;
+  std::vector<std::pair<std::uint64_t, std::pair<Index, Index>>> held; // key, [begin, end) in items
+  std::vector<std::uint64_t> seen;                                      // every cube with a local point
+  for (size_t g = 0; g < keyed.size();)
   {
-    return;
+    size_t h = g;
+    while (h < keyed.size() && keyed[h].Key == keyed[g].Key)
+    {
+      ++h;
+    }
+    const std::uint64_t key = keyed[g].Key;
+    seen.push_back(key);
+    bool complete = true;
+    if (d && lattice)
+    {
+      double centre[3];
+      CubeCentre(key, cubes, centre);
+      const double reach = d->Complete(centre);
+      complete = reach >= halfDiagonal;
+      if (!complete && d->OwnsPosition(centre))
+      {
+        this->BuildShortfall = std::max(this->BuildShortfall, halfDiagonal - reach);
+      }
+    }
+    if (complete)
+    {
+      const Index begin = static_cast<Index>(items.size());
+      for (size_t k = g; k < h; ++k)
+      {
+        items.push_back(keyed[k].It);
+      }
+      held.emplace_back(key, std::make_pair(begin, static_cast<Index>(items.size())));
+    }
+    g = h;
   }
-  // The splits move the points themselves (contiguous, cache-friendly), not indices into them.
-  std::vector<Item> items(order.size());
-  for (size_t s = 0; s < order.size(); ++s)
+  std::vector<Keyed>().swap(keyed);
+  this->Nodes.reserve(static_cast<size_t>(4 * (items.size() / kLeafSize + held.size() + 1)));
+  std::vector<Index> heldRoot(held.size());
+  for (size_t c = 0; c < held.size(); ++c)
   {
-    const Index i = order[s];
-    items[s] = Item{ { points[3 * i], points[3 * i + 1], points[3 * i + 2] }, i };
-  }
-  this->Nodes.reserve(static_cast<size_t>(4 * (order.size() / kLeafSize + 1)));
-  this->BuildNode(0, static_cast<Index>(items.size()), items);
-  for (size_t s = 0; s < items.size(); ++s)
-  {
-    order[s] = items[s].Id;
+    heldRoot[c] = this->BuildNode(held[c].second.first, held[c].second.second, items);
   }
   // Copy the points in tree order (leaves read them contiguously).
-  const size_t m = order.size();
+  const size_t m = items.size();
   this->Points.resize(3 * m);
   this->Normals.resize(3 * m);
   this->Areas.resize(m);
   this->Soft2.resize(m);
   for (size_t s = 0; s < m; ++s)
   {
-    const Index i = order[s];
+    const Index i = items[s].Id;
     const double* n = normals + 3 * i;
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     for (int a = 0; a < 3; ++a)
@@ -70,94 +153,219 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     }
     this->Areas[s] = areas[i];
     this->Soft2[s] = areas[i] / M_PI;
-    this->Total += areas[i];
   }
-  // Moments bottom-up (children always follow their parent in this->Nodes): leaves sum their points, inner
-  // nodes combine their children's moments moved to their own centre (O(n) in all).
+  std::vector<Item>().swap(items);
+  // Moments bottom-up (within a cube's tree children always follow their parent in this->Nodes): leaves sum their
+  // points, inner nodes combine their children's moments moved to their own centre (O(n) in all).
   for (size_t k = this->Nodes.size(); k-- > 0;)
   {
     Node& node = this->Nodes[k];
+    if (node.Left >= 0)
+    {
+      this->Combine(node);
+      continue;
+    }
     std::fill(node.Moment, node.Moment + 3, 0.0);
     std::fill(node.Second, node.Second + 9, 0.0);
     std::fill(node.Third, node.Third + 27, 0.0);
     double area = 0.0, c[3] = { 0, 0, 0 };
-    if (node.Left < 0)
+    for (Index s = node.Begin; s < node.End; ++s)
     {
-      for (Index s = node.Begin; s < node.End; ++s)
-      {
-        area += this->Areas[s];
-        for (int a = 0; a < 3; ++a)
-        {
-          c[a] += this->Areas[s] * this->Points[3 * s + a];
-        }
-      }
+      area += this->Areas[s];
       for (int a = 0; a < 3; ++a)
       {
-        node.Centre[a] = c[a] / area;
-      }
-      double r2 = 0.0;
-      for (Index s = node.Begin; s < node.End; ++s)
-      {
-        const double a = this->Areas[s];
-        const double* p = &this->Points[3 * s];
-        const double* n = &this->Normals[3 * s];
-        const double d[3] = { p[0] - node.Centre[0], p[1] - node.Centre[1], p[2] - node.Centre[2] };
-        for (int i = 0; i < 3; ++i)
-        {
-          node.Moment[i] += a * n[i];
-          for (int j = 0; j < 3; ++j)
-          {
-            node.Second[3 * i + j] += a * d[i] * n[j];
-            for (int l = 0; l < 3; ++l)
-            {
-              node.Third[9 * i + 3 * j + l] += a * n[i] * d[j] * d[l];
-            }
-          }
-        }
-        r2 = std::max(r2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      }
-      node.Radius = std::sqrt(r2);
-      node.Area = area;
-      continue;
-    }
-    const Node* children[2] = { &this->Nodes[node.Left], &this->Nodes[node.Right] };
-    for (const Node* child : children)
-    {
-      area += child->Area;
-      for (int a = 0; a < 3; ++a)
-      {
-        c[a] += child->Area * child->Centre[a];
+        c[a] += this->Areas[s] * this->Points[3 * s + a];
       }
     }
     for (int a = 0; a < 3; ++a)
     {
       node.Centre[a] = c[a] / area;
     }
-    node.Area = area;
-    node.Radius = 0.0;
-    for (const Node* child : children)
+    double r2 = 0.0;
+    for (Index s = node.Begin; s < node.End; ++s)
     {
-      // With d = d_child + e, e = c_child - c: Q = Q_child + e M^T, and
-      // C_abl = C_child,abl + Q_child,ba e_l + e_b Q_child,la + e_b e_l M_a.
-      const double e[3] = { child->Centre[0] - node.Centre[0], child->Centre[1] - node.Centre[1],
-        child->Centre[2] - node.Centre[2] };
-      const double* m = child->Moment;
-      const double* q = child->Second;
+      const double a = this->Areas[s];
+      const double* p = &this->Points[3 * s];
+      const double* n = &this->Normals[3 * s];
+      const double dd[3] = { p[0] - node.Centre[0], p[1] - node.Centre[1], p[2] - node.Centre[2] };
       for (int i = 0; i < 3; ++i)
       {
-        node.Moment[i] += m[i];
+        node.Moment[i] += a * n[i];
         for (int j = 0; j < 3; ++j)
         {
-          node.Second[3 * i + j] += q[3 * i + j] + e[i] * m[j];
+          node.Second[3 * i + j] += a * dd[i] * n[j];
           for (int l = 0; l < 3; ++l)
           {
-            node.Third[9 * i + 3 * j + l] +=
-              child->Third[9 * i + 3 * j + l] + q[3 * j + i] * e[l] + e[j] * q[3 * l + i] + e[j] * e[l] * m[i];
+            node.Third[9 * i + 3 * j + l] += a * n[i] * dd[j] * dd[l];
           }
         }
       }
-      node.Radius = std::max(node.Radius, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + child->Radius);
+      r2 = std::max(r2, dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]);
     }
+    node.Radius = std::sqrt(r2);
+    node.Area = area;
+  }
+  // Every cube's root: this process' own cubes' (by their centre) from the trees just built, the others' from the
+  // processes that own them (serial: all of them here).
+  std::vector<double> mine, all;
+  for (size_t c = 0; c < held.size(); ++c)
+  {
+    double centre[3];
+    CubeCentre(held[c].first, cubes, centre);
+    if (d && lattice && !d->OwnsPosition(centre))
+    {
+      continue;
+    }
+    const Node& root = this->Nodes[heldRoot[c]];
+    mine.push_back(static_cast<double>(held[c].first >> 32));
+    mine.push_back(static_cast<double>(held[c].first & 0xffffffffu));
+    mine.insert(mine.end(), root.Centre, root.Centre + 3);
+    mine.insert(mine.end(), root.Moment, root.Moment + 3);
+    mine.insert(mine.end(), root.Second, root.Second + 9);
+    mine.insert(mine.end(), root.Third, root.Third + 27);
+    mine.push_back(root.Radius);
+    mine.push_back(root.Area);
+  }
+  if (d)
+  {
+    d->Gather(mine, all);
+  }
+  else
+  {
+    all.swap(mine);
+  }
+  const size_t nc = all.size() / kRecord;
+  std::vector<std::pair<std::uint64_t, size_t>> gathered(nc);
+  for (size_t c = 0; c < nc; ++c)
+  {
+    const double* r = &all[kRecord * c];
+    gathered[c] = { (static_cast<std::uint64_t>(r[0]) << 32) | static_cast<std::uint64_t>(r[1]), c };
+  }
+  std::sort(gathered.begin(), gathered.end());
+  // A cube with local points that no process contributed: its owner did not see it (the halo fell short).
+  for (const std::uint64_t key : seen)
+  {
+    const auto it = std::lower_bound(gathered.begin(), gathered.end(), std::make_pair(key, size_t(0)));
+    if (it == gathered.end() || it->first != key)
+    {
+      this->BuildShortfall = std::max(this->BuildShortfall, halfDiagonal);
+    }
+  }
+  if (nc == 0)
+  {
+    this->Nodes.clear();
+    return;
+  }
+  // The top tree's leaves: the held cubes' roots, remote leaves for the others.
+  std::vector<Index> roots(nc);
+  size_t next = 0;
+  for (size_t c = 0; c < nc; ++c)
+  {
+    const std::uint64_t key = gathered[c].first;
+    while (next < held.size() && held[next].first < key)
+    {
+      ++next;
+    }
+    if (next < held.size() && held[next].first == key)
+    {
+      roots[c] = heldRoot[next];
+      continue;
+    }
+    const double* r = &all[kRecord * gathered[c].second + 2];
+    Node node;
+    std::copy(r, r + 3, node.Centre);
+    std::copy(r + 3, r + 6, node.Moment);
+    std::copy(r + 6, r + 15, node.Second);
+    std::copy(r + 15, r + 42, node.Third);
+    node.Radius = r[42];
+    node.Area = r[43];
+    node.Begin = node.End = 0;
+    node.Left = node.Right = -2;
+    roots[c] = static_cast<Index>(this->Nodes.size());
+    this->Nodes.push_back(node);
+  }
+  this->Root = this->BuildTop(roots, 0, nc);
+  this->Total = this->Nodes[this->Root].Area;
+}
+
+Index WindingNumber::BuildTop(std::vector<Index>& roots, size_t begin, size_t end)
+{
+  if (end - begin == 1)
+  {
+    return roots[begin];
+  }
+  double lo[3] = { HUGE_VAL, HUGE_VAL, HUGE_VAL }, hi[3] = { -HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
+  for (size_t k = begin; k < end; ++k)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = std::min(lo[a], this->Nodes[roots[k]].Centre[a]);
+      hi[a] = std::max(hi[a], this->Nodes[roots[k]].Centre[a]);
+    }
+  }
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+  {
+    axis = hi[a] - lo[a] > hi[axis] - lo[axis] ? a : axis;
+  }
+  // roots[begin, end) are in key order; a stable sort by the centre keeps ties in key order.
+  std::stable_sort(roots.begin() + static_cast<std::ptrdiff_t>(begin), roots.begin() + static_cast<std::ptrdiff_t>(end),
+    [this, axis](Index a, Index b) { return this->Nodes[a].Centre[axis] < this->Nodes[b].Centre[axis]; });
+  const size_t mid = begin + (end - begin) / 2;
+  const Index left = this->BuildTop(roots, begin, mid);
+  const Index right = this->BuildTop(roots, mid, end);
+  Node node;
+  node.Begin = node.End = 0;
+  node.Left = left;
+  node.Right = right;
+  this->Combine(node);
+  this->Nodes.push_back(node);
+  return static_cast<Index>(this->Nodes.size() - 1);
+}
+
+void WindingNumber::Combine(Node& node) const
+{
+  std::fill(node.Moment, node.Moment + 3, 0.0);
+  std::fill(node.Second, node.Second + 9, 0.0);
+  std::fill(node.Third, node.Third + 27, 0.0);
+  double area = 0.0, c[3] = { 0, 0, 0 };
+  const Node* children[2] = { &this->Nodes[node.Left], &this->Nodes[node.Right] };
+  for (const Node* child : children)
+  {
+    area += child->Area;
+    for (int a = 0; a < 3; ++a)
+    {
+      c[a] += child->Area * child->Centre[a];
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    node.Centre[a] = c[a] / area;
+  }
+  node.Area = area;
+  node.Radius = 0.0;
+  for (const Node* child : children)
+  {
+    // With d = d_child + e, e = c_child - c: Q = Q_child + e M^T, and
+    // C_abl = C_child,abl + Q_child,ba e_l + e_b Q_child,la + e_b e_l M_a.
+    const double e[3] = { child->Centre[0] - node.Centre[0], child->Centre[1] - node.Centre[1],
+      child->Centre[2] - node.Centre[2] };
+    const double* m = child->Moment;
+    const double* q = child->Second;
+    for (int i = 0; i < 3; ++i)
+    {
+      node.Moment[i] += m[i];
+      for (int j = 0; j < 3; ++j)
+      {
+        node.Second[3 * i + j] += q[3 * i + j] + e[i] * m[j];
+        for (int l = 0; l < 3; ++l)
+        {
+          node.Third[9 * i + 3 * j + l] +=
+            child->Third[9 * i + 3 * j + l] + q[3 * j + i] * e[l] + e[j] * q[3 * l + i] + e[j] * e[l] * m[i];
+        }
+      }
+    }
+    node.Radius = std::max(node.Radius, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + child->Radius);
   }
 }
 
@@ -212,7 +420,7 @@ double WindingNumber::DipoleLength() const
   {
     return 0.0;
   }
-  const double* m = this->Nodes[0].Moment;
+  const double* m = this->Nodes[this->Root].Moment;
   return std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
 }
 
@@ -229,7 +437,7 @@ double WindingNumber::Evaluate(const double x[3], double gradient[3]) const
   }
   Index stack[128];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = this->Root;
   while (top > 0)
   {
     const Node& node = this->Nodes[stack[--top]];
@@ -272,6 +480,16 @@ double WindingNumber::Evaluate(const double x[3], double gradient[3]) const
           g[a] += kInverseFourPi * inv3 * (-m[a] + 3.0 * mr * r[a] * inv2);
         }
       }
+      continue;
+    }
+    if (node.Left == -2)
+    {
+      // A cube another process holds, too near to be summed by its expansion: the halo fell short (counted; the
+      // caller widens it and evaluates again). Its expansion stands in meanwhile.
+      this->Opened = true;
+      const double inv2 = 1.0 / std::max(r2, 1e-300);
+      const double* m = node.Moment;
+      w += kInverseFourPi * inv2 * std::sqrt(inv2) * (m[0] * r[0] + m[1] * r[1] + m[2] * r[2]);
       continue;
     }
     if (node.Left < 0)

@@ -22,16 +22,37 @@
  * nearer nodes are opened, leaves summed directly. The gradient uses the first-order term. The
  * direct terms are regularised within sqrt(a_i / pi) of a point (the disc it stands for), so w stays finite on
  * the data. Cost per evaluation O(log n) for points far from the data, a few leaves more near them.
+ *
+ * Cubes (Build with WindingCubes): the points are first bucketed in cubes of a fixed lattice (edge Size, from
+ * Origin), each cube gets its own tree, and a top tree (median splits of the cubes' centres) joins the cubes' roots
+ * by the same moment formulas. The tree then depends on the set of points and the lattice only, which lets
+ * processes that each hold a region of the cloud and a halo (Common/Distribution.h) evaluate the whole cloud's w
+ * with the serial bits: a process builds the cubes it holds completely (every point within Size sqrt(3) / 2 of the
+ * cube's centre: Distribution::Complete), the owner of each cube's centre (OwnsPosition) contributes its root's
+ * moments, every process gathers them and builds the same top tree; a cube it does not hold is a leaf summed by its
+ * expansion. An evaluation that would need to open such a cube is counted (Incomplete()): the halo was too narrow.
  */
 #ifndef meshfree_WindingNumber_h
 #define meshfree_WindingNumber_h
 
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
+
+#include <atomic>
+#include <cmath>
 
 #include <vector>
 
 namespace meshfree
 {
+
+/// The cube lattice of a WindingNumber (see the class comment); Size <= 0: one cube (a single tree).
+struct WindingCubes
+{
+  double Size = 0.0;
+  double Origin[3] = { 0.0, 0.0, 0.0 };
+  const Distribution* Processes = nullptr; // distributed (collective Build); null: serial
+};
 
 class WindingNumber
 {
@@ -39,6 +60,14 @@ public:
   /// Points (3 per point), unit outward normals (3 per point) and areas (1 per point); points with a zero or
   /// non-finite normal, area or coordinate are left out. Beta >= 1 is the opening criterion (default 2).
   void Build(const double* points, const double* normals, const double* areas, Index count, double beta = 2.0);
+  /// The same over a cube lattice (collective when distributed).
+  void Build(const double* points, const double* normals, const double* areas, Index count, const WindingCubes& cubes,
+    double beta = 2.0);
+
+  /// Distributed: how far the halo fell short of a cube this process owns (<= 0: complete; -infinity serial), and
+  /// whether an evaluation needed a cube this process does not hold (then its expansion was used).
+  double Shortfall() const { return this->BuildShortfall; }
+  bool Incomplete() const { return this->Opened.load(); }
 
   /// w(x); when gradient is not null, grad w(x) (first order in the far nodes).
   double Evaluate(const double x[3], double gradient[3] = nullptr) const;
@@ -62,7 +91,7 @@ private:
     double Radius;     // bounds |p - c| over the node's points
     double Area;
     Index Begin, End;  // points [Begin, End) in this->Points' order
-    Index Left, Right; // children (-1 for a leaf)
+    Index Left, Right; // children (-1 for a leaf; -2 for a cube another process holds)
   };
   struct Item
   {
@@ -70,7 +99,14 @@ private:
     Index Id;
   };
   Index BuildNode(Index begin, Index end, std::vector<Item>& items);
+  /// A top tree over the cube roots roots[begin, end) (sorted by key; ties of the median by key).
+  Index BuildTop(std::vector<Index>& roots, size_t begin, size_t end);
+  /// The moments of `node` from its two children's.
+  void Combine(Node& node) const;
   std::vector<Node> Nodes;
+  Index Root = 0;
+  double BuildShortfall = -HUGE_VAL;
+  mutable std::atomic<bool> Opened{ false };
   std::vector<double> Points, Normals, Areas, Soft2; // tree order; Soft2: regularisation radius squared
   double Beta2 = 4.0;
   double Total = 0.0;
