@@ -136,39 +136,6 @@ void WrapMesh(const meshfree::SurfaceMesh& mesh, vtkPolyData* output)
   output->GetPointData()->AddArray(distance);
 }
 
-/// Triangles [begin, end) of `mesh` with the vertices they use, in the order of their indices in `mesh`; `kept`
-/// receives those indices.
-meshfree::SurfaceMesh TriangleShare(const meshfree::SurfaceMesh& mesh, vtkIdType begin, vtkIdType end, vtkIdList* kept)
-{
-  meshfree::SurfaceMesh share;
-  std::vector<meshfree::Index> index(static_cast<size_t>(mesh.NumberOfPoints()), -1);
-  for (vtkIdType c = 3 * begin; c < 3 * end; ++c)
-  {
-    index[mesh.Triangles[c]] = 0;
-  }
-  meshfree::Index used = 0;
-  for (size_t v = 0; v < index.size(); ++v)
-  {
-    if (index[v] < 0)
-    {
-      continue;
-    }
-    index[v] = used++;
-    kept->InsertNextId(static_cast<vtkIdType>(v));
-    share.Points.insert(share.Points.end(), &mesh.Points[3 * v], &mesh.Points[3 * v] + 3);
-    share.Normals.insert(share.Normals.end(), &mesh.Normals[3 * v], &mesh.Normals[3 * v] + 3);
-    if (mesh.DistanceToData.size() == mesh.Normals.size() / 3)
-    {
-      share.DistanceToData.push_back(mesh.DistanceToData[v]);
-    }
-  }
-  share.Triangles.reserve(static_cast<size_t>(3 * (end - begin)));
-  for (vtkIdType c = 3 * begin; c < 3 * end; ++c)
-  {
-    share.Triangles.push_back(index[mesh.Triangles[c]]);
-  }
-  return share;
-}
 } // namespace
 
 vtkMeshlessSurface::vtkMeshlessSurface() = default;
@@ -354,17 +321,6 @@ void UnpackRows(const double* rows, vtkIdType count, int width, bool useNormals,
   }
 }
 } // namespace
-
-void vtkMeshlessSurface::GatherInput(vtkPointSet* input, vtkMultiProcessController* controller, Cloud& cloud)
-{
-  // Gathered whole under MPI.
-  Layout layout;
-  this->PrepareInput(input, controller, cloud, layout);
-  const vtkMeshFreePieces::GatheredCloud all =
-    vtkMeshFreePieces::GatherCloud(controller, input, layout.Rows, layout.Width);
-  std::vector<double>().swap(layout.Rows);
-  UnpackRows(all.Rows.data(), all.Count, layout.Width, layout.UseNormals, layout.UseVolumes, cloud);
-}
 
 void vtkMeshlessSurface::ReportReconstruction(const Cloud& cloud, const Result& result, vtkIdType boundaryEdges)
 {
@@ -639,6 +595,13 @@ int vtkMeshlessSurface::ReconstructDistributed(
     invalid += std::isfinite(xyz[3 * i]) && std::isfinite(xyz[3 * i + 1]) && std::isfinite(xyz[3 * i + 2]) ? 0 : 1;
   }
   invalid = vtkMeshFreeHalo::GlobalSum(controller, invalid);
+  vtkIdType invalidVolumes = 0;
+  for (vtkIdType i = 0; i < n && layout.UseVolumes; ++i)
+  {
+    const double v = tail->GetComponent(i, layout.UseNormals ? 3 : 0);
+    invalidVolumes += v > 0.0 && std::isfinite(v) ? 0 : 1;
+  }
+  invalidVolumes = vtkMeshFreeHalo::GlobalSum(controller, invalidVolumes);
 
   // Space cut in slabs of equal shares, the points moved to their slab's rank; then a halo around each slab,
   // widened while the core reports a shortfall (the last attempt takes every point, always enough).
@@ -697,16 +660,12 @@ int vtkMeshlessSurface::ReconstructDistributed(
     in.Points = cloud.Points.data();
     in.Count = cloud.Count;
     in.Normals = cloud.Normals.empty() ? nullptr : cloud.Normals.data();
+    in.Volumes = cloud.Volumes.empty() ? nullptr : cloud.Volumes.data();
     options.Processes = &processes;
     std::string error;
     const bool done = meshfree::ReconstructSurface(in, options, result.Mesh, result.Report, error,
       attempt == 0 ? vtkMeshFreeFilterSupport::Progress(this, 0.0, 0.9) : meshfree::ProgressCallback());
     options.Processes = nullptr;
-    if (vtkMeshFreeHalo::GlobalMax(controller, result.Report.NotDistributed ? 1.0 : 0.0) > 0.0)
-    {
-      vtkDebugMacro("Falling back to the gathered cloud: " << error);
-      return 0; // every rank alike: the caller gathers
-    }
     if (!done && !result.Report.Aborted)
     {
       vtkErrorMacro("Invalid settings: " << error << " The output is empty.");
@@ -741,7 +700,7 @@ int vtkMeshlessSurface::ReconstructDistributed(
   {
     Cloud whole;
     whole.Count = total;
-    whole.InvalidVolumes = 0;
+    whole.InvalidVolumes = invalidVolumes;
     Result summary;
     summary.Report = report;
     summary.Report.Contour.ActiveCells = triangles > 0 ? report.Contour.ActiveCells : 0;
@@ -793,28 +752,22 @@ int vtkMeshlessSurface::RequestData(
   }
   output->Initialize();
 
-  // Under MPI (a piece of several, on several ranks): every rank gathers the whole cloud and reconstructs the whole
-  // surface, then keeps its share of the triangles (see the class doc).
+  // Under MPI (a piece of several, on several ranks): each rank its slab of space and a halo (see the class doc).
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  const bool distributed = vtkMeshFreePieces::IsDistributed(outInfo);
-  vtkMultiProcessController* controller = distributed ? vtkMultiProcessController::GetGlobalController() : nullptr;
-  const bool reporter = !distributed || controller->GetLocalProcessId() == 0; // one rank warns about the cloud
-
-  // Distributed: each rank its slab of space and a halo (MLS, WLS; SPH still gathers, below).
-  if (distributed && this->Method != SPH && this->ReconstructDistributed(input, controller, output))
+  if (vtkMeshFreePieces::IsDistributed(outInfo))
   {
-    return 1;
+    return this->ReconstructDistributed(input, vtkMultiProcessController::GetGlobalController(), output);
   }
 
-  // Validate and gather.
+  // Validate.
   Cloud cloud;
-  this->GatherInput(input, controller, cloud);
+  Layout layout;
+  this->PrepareInput(input, nullptr, cloud, layout);
+  UnpackRows(layout.Rows.data(), input->GetNumberOfPoints(), layout.Width, layout.UseNormals, layout.UseVolumes, cloud);
+  std::vector<double>().swap(layout.Rows);
   if (cloud.Count == 0)
   {
-    if (reporter)
-    {
-      vtkWarningMacro("The input has no points: no surface.");
-    }
+    vtkWarningMacro("The input has no points: no surface.");
     return 1;
   }
 
@@ -838,46 +791,9 @@ int vtkMeshlessSurface::RequestData(
     vtkErrorMacro("Invalid settings: " << error << " The output is empty.");
     return 1;
   }
-  if (reporter)
-  {
-    this->ReportReconstruction(cloud, result);
-  }
-
-  // This rank's share of the triangles (all of them when not distributed), then wrap it and approximate the input's
-  // arrays at its vertices.
-  // (Distributed, the arrays are approximated at every vertex first: the approximation of a vertex may differ in
-  // the last bit with the set of vertices evaluated together, and the share must equal serial bit for bit.)
-  vtkNew<vtkPolyData> whole;
-  WrapMesh(result.Mesh, distributed ? whole.Get() : output);
-  this->AddApproximatedArrays(cloud, distributed ? whole.Get() : output, result, reporter);
-  if (distributed && !result.Aborted)
-  {
-    const vtkMeshFreePieces::Range share = vtkMeshFreePieces::OutputShare(outInfo, result.Mesh.NumberOfTriangles());
-    vtkNew<vtkIdList> kept;
-    WrapMesh(TriangleShare(result.Mesh, share.Begin, share.End, kept), output);
-    vtkPointData* from = whole->GetPointData();
-    vtkPointData* to = output->GetPointData();
-    for (int a = 0; a < from->GetNumberOfArrays(); ++a)
-    {
-      vtkAbstractArray* array = from->GetAbstractArray(a);
-      if (!array->GetName() || std::strcmp(array->GetName(), kNormals) == 0 ||
-        std::strcmp(array->GetName(), kDistanceToData) == 0)
-      {
-        continue;
-      }
-      vtkSmartPointer<vtkAbstractArray> part = vtkSmartPointer<vtkAbstractArray>::Take(array->NewInstance());
-      part->SetName(array->GetName());
-      part->SetNumberOfComponents(array->GetNumberOfComponents());
-      part->CopyComponentNames(array);
-      part->SetNumberOfTuples(kept->GetNumberOfIds());
-      array->GetTuples(kept, part);
-      to->AddArray(part);
-    }
-    if (from->GetScalars() && from->GetScalars()->GetName())
-    {
-      to->SetActiveScalars(from->GetScalars()->GetName());
-    }
-  }
+  this->ReportReconstruction(cloud, result);
+  WrapMesh(result.Mesh, output);
+  this->AddApproximatedArrays(cloud, output, result, true);
   if (result.Aborted)
   {
     output->Initialize();

@@ -39,7 +39,7 @@
  * Under MPI (pvbatch, pvserver: each rank's input is piece = rank of N) the pieces' outputs together are the
  * serial surface, each triangle on exactly one rank, with the serial vertex positions, Normals, DistanceToData and
  * approximated arrays bit for bit.
- * - MLS and WLS are distributed: space is cut in one slab per rank along the cloud's longest axis at the quantiles
+ * - Every method is distributed: space is cut in one slab per rank along the cloud's longest axis at the quantiles
  *   of its points (exact distributed selections), every point moves to its slab's rank, and each rank brings in a
  *   halo (every point within a radius of its slab, vtkMeshFreeHalo: first 8 neighbourhood radii, widened and
  *   recomputed when the core reports that a computation reached beyond it). Each rank estimates its own points'
@@ -50,10 +50,9 @@
  *   cubes near it from its halo and the others by their moments, gathered from their owners (WindingNumber.h).
  *   Stray pieces are judged on the whole mesh (pieces joined across the seams). A rank holds its slab and a band of
  *   halo, never the whole cloud unless the halo needs it (field data `LocalCloudPoints`, `HaloRadius`,
- *   `HaloAttempts`, per rank). Each rank's output is its slab's part (not the ParaView piece it was given).
- * - SPH still gathers: every rank gathers the whole cloud (coordinates, volumes and the arrays to approximate),
- *   puts it in global id order (GlobalIds, else the rank-by-rank concatenation), runs the serial reconstruction and
- *   keeps triangles [T r / N, T (r + 1) / N) of its T with the vertices they use.
+ *   `HaloAttempts`, per rank). Each rank's output is its slab's part (not the ParaView piece it was given). The
+ *   SPH method's kernel radius and bulk volume come from a sample of particles chosen by a hash of their positions
+ *   (the same sample in any order and split), evaluated where each is owned.
  * A point array is approximated when every rank with points has it (same name, components); otherwise none is,
  * with a warning. An input that every rank holds whole (piece 0 of 1 on each rank) is reconstructed locally,
  * whole, without communication.
@@ -212,7 +211,6 @@ private:
   struct Result;
   struct Layout;
   void PrepareInput(vtkPointSet* input, vtkMultiProcessController* controller, Cloud& cloud, Layout& layout);
-  void GatherInput(vtkPointSet* input, vtkMultiProcessController* controller, Cloud& cloud);
   int ReconstructDistributed(vtkPointSet* input, vtkMultiProcessController* controller, vtkPolyData* output);
   meshfree::SurfaceOptions Options() const;
   void AddFieldData(vtkPolyData* output, const Result& result);

@@ -265,6 +265,9 @@ for seed in (1, 2, 3):
 surface_case("redistributed", 20000, "redistribute", max_share=0.8 if mm.RANKS == 2 else 0.9, distributed=True)
 surface_case("with_nan", 3000, "even", nans=7, HoleFilling="Off", distributed=True)
 surface_case("all_on_last_rank", 3000, "last", distributed=True)
+# The SPH colour field of the same points taken as particles.
+surface_case("sph", 3000, "even", Method="SPH", distributed=True)
+surface_case("sph_slabs", 40000, "slab", Method="SPH", distributed=True, max_share=0.7 if mm.RANKS == 2 else 0.8)
 
 # One point: no hang, nothing computed, the point on exactly one rank.
 normals_case("one_point", 1, "even")

@@ -20,7 +20,8 @@ constexpr double Pi = 3.141592653589793238462643383279502884;
 
 } // namespace
 
-bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes, const FluidSurfaceOptions& options)
+bool FluidSurface::SetParticles(
+  const NeighborGrid& grid, const double* volumes, const FluidSurfaceOptions& options, const Distribution* d)
 {
   this->Grid = &grid;
   this->Options = options;
@@ -31,7 +32,8 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
   this->Transforms.clear();
   this->Determinants.clear();
   this->Volume = 0.0;
-  if (nv == 0)
+  this->SampleShortfall = -HUGE_VAL;
+  if (GlobalSum(d, nv) == 0)
   {
     this->H = 0.0;
     return false;
@@ -39,9 +41,17 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
   const double* sorted = grid.SortedPoints();
   const std::vector<Index>& order = grid.SortedOrder();
 
-  // The kernel radius: twice the spacing that the k-nearest balls of a sample of particles give.
+  // The kernel radius: twice the spacing that the k-nearest balls of a sample of particles give (the sample: the
+  // whole cloud's particles whose positions hash lowest, each evaluated where it is owned).
   constexpr int k = 20;
-  const Index samples = std::min<Index>(nv, 2048);
+  CloudSample sample;
+  // (Distinct positions only: exact duplicates, which particles may have, hash alike; a cell's points are sorted by
+  // position, so a duplicate follows its first copy.)
+  sample.Choose(d, sorted, nv, 2048, [d, &order, sorted](Index s) {
+    return IsOwn(d, order[s]) && (s == 0 || !std::equal(sorted + 3 * s, sorted + 3 * s + 3, sorted + 3 * (s - 1)));
+  });
+  const std::vector<Index>& mine = sample.Local();
+  const Index samples = static_cast<Index>(mine.size());
   std::vector<double> kth(static_cast<size_t>(samples), 0.0);
   // Per-thread query buffers, reused by the three loops below.
   struct Query
@@ -54,11 +64,15 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
     Query& q = queries.Local();
     for (Index j = begin; j < end; ++j)
     {
-      const int found = grid.FindKNearest(sorted + 3 * (j * nv / samples), k + 1, q.Ids, q.Dist2);
+      const int found = grid.FindKNearest(sorted + 3 * mine[j], k + 1, q.Ids, q.Dist2);
       kth[j] = found > 0 ? std::sqrt(q.Dist2[found - 1]) : 0.0;
     }
   });
-  const double rk = Median(kth);
+  for (Index j = 0; d && j < samples; ++j)
+  {
+    this->SampleShortfall = std::max(this->SampleShortfall, meshfree::Shortfall(d, sorted + 3 * mine[j], kth[j]));
+  }
+  const double rk = Median(sample.Gather(d, kth));
   const double spacing0 = rk * std::cbrt(4.0 / 3.0 * Pi / (k + 1));
   this->H = options.SupportRadius > 0.0 ? options.SupportRadius : 2.0 * spacing0;
   if (!(this->H > 0.0) || !std::isfinite(this->H))
@@ -79,7 +93,7 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
     Query& q = queries.Local();
     for (Index j = begin; j < end; ++j)
     {
-      grid.FindWithinRadiusPositions(sorted + 3 * (j * nv / samples), this->H, q.Ids, q.Dist2);
+      grid.FindWithinRadiusPositions(sorted + 3 * mine[j], this->H, q.Ids, q.Dist2);
       double sum = 0.0;
       for (double r2 : q.Dist2)
       {
@@ -88,7 +102,11 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
       density[j] = sum;
     }
   });
-  const double bulk = Median(density);
+  for (Index j = 0; d && j < samples; ++j)
+  {
+    this->SampleShortfall = std::max(this->SampleShortfall, meshfree::Shortfall(d, sorted + 3 * mine[j], this->H));
+  }
+  const double bulk = Median(sample.Gather(d, density));
   const double v0 = bulk > 0.0 ? 1.0 / bulk : 0.125; // relative to H^3
   this->ParticleSpacing = this->H * std::cbrt(v0);
   this->Volumes.assign(static_cast<size_t>(nv), v0);
@@ -100,9 +118,9 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
     {
       this->Volumes[s] = volumes[id] * invH * invH * invH;
     }
-    total += this->Volumes[s];
+    total += IsOwn(d, id) ? this->Volumes[s] : 0.0;
   }
-  this->Volume = total * this->H * this->H * this->H;
+  this->Volume = GlobalSum(d, total) * this->H * this->H * this->H;
   this->QueryRadius = this->H;
   if (!options.Anisotropic)
   {
@@ -185,7 +203,7 @@ bool FluidSurface::SetParticles(const NeighborGrid& grid, const double* volumes,
       a.Shift = std::max(a.Shift, b.Shift);
       return a;
     });
-  this->QueryRadius = this->H * largest.Stretch + largest.Shift;
+  this->QueryRadius = this->H * GlobalMax(d, largest.Stretch) + GlobalMax(d, largest.Shift);
   return true;
 }
 

@@ -20,11 +20,18 @@
  * weighted covariance of its neighbours within 2 x spacing (singular values s clamped to >= s_max / kr,
  * isotropic where fewer than Nmin neighbours), scaled to the volume of the isotropic kernel, and centred at the
  * Laplacian-smoothed position x_j + lambda (xbar_j - x_j). Flat surfaces stay flat and thin sheets thin.
+ *
+ * Distributed (a Distribution d: the grid holds a process' particles and their halo, framed by the whole cloud):
+ * the sample is the whole cloud's 2,048 particles whose positions hash lowest (Common/Distribution.h's
+ * CloudSample, serially too), each evaluated by its owner and gathered, so H and V0 are the serial ones; the
+ * kernels of the halo's particles are computed like the own ones' (they read neighbours within twice the
+ * spacing), the query radius's maxima are taken over every process, the total volume summed over them.
  */
 #ifndef meshfree_FluidSurface_h
 #define meshfree_FluidSurface_h
 
 #include "Common/Kernels.h"
+#include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 #include "Surface/ImplicitField.h"
 
@@ -48,7 +55,11 @@ class FluidSurface : public ImplicitField
 public:
   /// The particles: `grid` built over them; volumes (V_j, caller's order) or null. Computes the kernel
   /// radius, the volumes and, when asked, the anisotropic kernels. False when there are no valid particles.
-  bool SetParticles(const NeighborGrid& grid, const double* volumes, const FluidSurfaceOptions& options);
+  bool SetParticles(const NeighborGrid& grid, const double* volumes, const FluidSurfaceOptions& options,
+    const Distribution* d = nullptr);
+  /// Distributed: how far the sample's queries reached beyond the complete part of the local cloud (<= 0:
+  /// complete; -infinity serially).
+  double Shortfall() const { return this->SampleShortfall; }
 
   bool Evaluate(const double x[3], double& value, double gradient[3], FieldScratch& scratch) const override;
 
@@ -68,6 +79,7 @@ private:
   double H = 0.0;
   double ParticleSpacing = 0.0;
   double Volume = 0.0;
+  double SampleShortfall = -HUGE_VAL;
   double QueryRadius = 0.0;
   std::vector<double> Volumes;    // sorted order, V_j / H^3
   std::vector<double> Centres;    // sorted order, 3 per particle (smoothed when anisotropic)

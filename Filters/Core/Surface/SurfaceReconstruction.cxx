@@ -355,12 +355,6 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   const auto seconds = [](Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); };
   auto start = Clock::now();
   const Distribution* processes = options.Processes;
-  if (processes && options.Method == SurfaceMethod::SPH)
-  {
-    report.NotDistributed = true;
-    error = "The SPH surface is not distributed yet.";
-    return false;
-  }
   NeighborGrid grid;
   if (options.Framed)
   {
@@ -434,7 +428,8 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     fo.SupportRadius = options.SupportRadius;
     fo.Level = options.Level;
     fo.Anisotropic = options.Anisotropic;
-    fluid->SetParticles(grid, input.Volumes, fo);
+    fluid->SetParticles(grid, input.Volumes, fo, processes);
+    report.Shortfall = std::max(report.Shortfall, fluid->Shortfall());
     report.SupportRadius = fluid->SupportRadius();
     report.ParticleVolume = fluid->TotalVolume();
     if (!(cell > 0.0))
@@ -446,10 +441,12 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     // Every particle may seed, but one deep in the fluid (colour above 0.9 or below 0.1: |level - c| >= 0.4,
     // a flat field where projection has no direction) is passed over.
     const std::vector<unsigned char> near(static_cast<size_t>(input.Count), 1);
-    seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near, 0.4);
-    if (seeds.empty())
+    seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near, 0.4, processes);
+    if (GlobalSum(processes, static_cast<Index>(seeds.size())) == 0)
     {
-      seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near); // a lone droplet: no bulk
+      // A lone droplet: no bulk.
+      seeds = SeedCells(grid, *fluid, lattice, 2.0 * fluid->SupportRadius(), near,
+        std::numeric_limits<double>::infinity(), processes);
     }
     field = std::move(fluid);
     if (progress && !progress(0.2))
@@ -562,8 +559,10 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   if (d)
   {
     // The fits read the samples within the largest support (at most 3 x the median) of a corner, up to a cell
-    // from a vertex, and the projection moves a vertex by at most a cell.
-    const double reach = 3.0 * report.SupportRadius + 2.0 * lattice.CellSize;
+    // from a vertex, and the projection moves a vertex by at most a cell; the fluid's kernels (H, stretched up to
+    // 4^(2/3) and shifted) read their particles' neighbours within two spacings (H).
+    const double reach = (options.Method == SurfaceMethod::SPH && options.Anisotropic ? 4.5 : 3.0) *
+        report.SupportRadius + 2.0 * lattice.CellSize;
     for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
     {
       report.Shortfall = std::max(report.Shortfall, Shortfall(d, &mesh.Points[3 * v], reach));

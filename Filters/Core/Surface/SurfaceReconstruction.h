@@ -133,7 +133,6 @@ struct SurfaceReport
   // Distributed: how far beyond the complete part of the local cloud a computation reached (Distribution.h's
   // Shortfall; > 0: widen the halo by it and rerun); -infinity when serial.
   double Shortfall = -HUGE_VAL;
-  bool NotDistributed = false; // distributed: this case needs the whole cloud on every process (false returned)
   bool Aborted = false;
 };
 
