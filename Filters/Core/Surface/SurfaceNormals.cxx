@@ -624,10 +624,40 @@ bool NearestOfList(const double* sorted, const Index* pos, const double* r2, siz
   {
     return false;
   }
-  std::nth_element(keys.begin(), keys.begin() + (k - 1), keys.begin() + static_cast<std::ptrdiff_t>(kept2));
-  kth = std::sqrt(keys[k - 1]);
+  // The k-th smallest is the (kept2 - k + 1)-th largest: usually few (the first bound holds a little more than k),
+  // kept sorted by insertion, which is cheaper than a selection over all of them.
+  constexpr size_t MaxLargest = 16;
+  const size_t largest = kept2 - static_cast<size_t>(k) + 1;
+  double kth2;
+  if (largest <= MaxLargest)
+  {
+    double top[MaxLargest]; // descending
+    size_t held = 0;
+    for (size_t j = 0; j < kept2; ++j)
+    {
+      const double v = keys[j];
+      if (held == largest && !(v > top[largest - 1]))
+      {
+        continue;
+      }
+      size_t at = held < largest ? held++ : largest - 1;
+      while (at > 0 && top[at - 1] < v)
+      {
+        top[at] = top[at - 1];
+        --at;
+      }
+      top[at] = v;
+    }
+    kth2 = top[largest - 1];
+  }
+  else
+  {
+    std::nth_element(keys.begin(), keys.begin() + (k - 1), keys.begin() + static_cast<std::ptrdiff_t>(kept2));
+    kth2 = keys[k - 1];
+  }
+  kth = std::sqrt(kth2);
   // The degree <= k nearest lie within the k-th distance.
-  limit2 = keys[k - 1];
+  limit2 = kth2;
   // The `degree` first in the neighbour order, kept sorted by insertion (degree is small).
   constexpr int MaxDegree = 64;
   const int want = std::min(std::min(degree, k), MaxDegree);
@@ -800,32 +830,39 @@ void FlagOutliers(NormalField& field, const Distribution* d)
   const double threshold =
     std::max(6.0 * GlobalMedian(d, std::move(residuals)), 0.05 * GlobalMedian(d, std::move(distances)));
   const int k = field.GraphDegree;
-  for (size_t i = 0; i < n; ++i)
-  {
-    if (!field.Valid[i] || !IsOwn(d, static_cast<Index>(i)))
-    {
-      continue;
-    }
-    // Isolated: its k-th neighbour three times farther than its nearest neighbours' (a sparse region of a
-    // scan has sparse neighbours too, so only points alone in their surroundings qualify).
-    double around = 0.0;
-    int counted = 0;
-    for (int j = 0; j < k; ++j)
-    {
-      const std::int32_t v = field.Graph[i * k + j];
-      if (v >= 0)
+  // In parallel: the neighbours' r_k are read by original index (cache misses).
+  field.OutlierCount += ParallelReduce(static_cast<Index>(n), 4096, Index(0),
+    [&](Index b0, Index b1) {
+      Index flagged = 0;
+      for (Index i = b0; i < b1; ++i)
       {
-        around += field.NeighborDistance[v];
-        ++counted;
+        if (!field.Valid[i] || !IsOwn(d, i))
+        {
+          continue;
+        }
+        // Isolated: its k-th neighbour three times farther than its nearest neighbours' (a sparse region of a
+        // scan has sparse neighbours too, so only points alone in their surroundings qualify).
+        double around = 0.0;
+        int counted = 0;
+        for (int j = 0; j < k; ++j)
+        {
+          const std::int32_t v = field.Graph[static_cast<size_t>(i) * k + j];
+          if (v >= 0)
+          {
+            around += field.NeighborDistance[v];
+            ++counted;
+          }
+        }
+        const bool isolated = counted > 0 && field.NeighborDistance[i] > 3.0 * around / counted;
+        if (isolated || field.Residual[i] > threshold)
+        {
+          field.Outlier[i] = 1;
+          ++flagged;
+        }
       }
-    }
-    const bool isolated = counted > 0 && field.NeighborDistance[i] > 3.0 * around / counted;
-    if (isolated || field.Residual[i] > threshold)
-    {
-      field.Outlier[i] = 1;
-      ++field.OutlierCount;
-    }
-  }
+      return flagged;
+    },
+    [](Index a, Index b) { return a + b; });
   UpdateHalo(d, field.Outlier);
 }
 
@@ -1111,8 +1148,10 @@ bool EstimateNormals(
   std::vector<double> rms(static_cast<size_t>(nv), 0.0), height(static_cast<size_t>(nv), 0.0);
   struct Buffers
   {
-    std::vector<Index> Ids, Positions, Small, Local;
-    std::vector<double> Dist2, Radius2, Keys, SmallD2;
+    std::vector<Index> Ids, Local;
+    std::vector<double> Dist2, Keys;
+    detail::Buffer<Index> Positions, Small;
+    detail::Buffer<double> Radius2, SmallD2;
     double Shortfall = -HUGE_VAL;
   };
   PerThread<Buffers> buffers;
@@ -1123,9 +1162,9 @@ bool EstimateNormals(
       [&](Index b0, Index b1) {
         Buffers& mine = buffers.Local();
         std::vector<Index>& ids = mine.Ids;
-        std::vector<Index>& pos = mine.Positions;
+        detail::Buffer<Index>& pos = mine.Positions;
         std::vector<double>& d2 = mine.Dist2;
-        std::vector<double>& r2 = mine.Radius2;
+        detail::Buffer<double>& r2 = mine.Radius2;
         std::vector<double>& keys = mine.Keys;
         Index failed = 0;
         double& shortfall = mine.Shortfall;
@@ -1147,8 +1186,9 @@ bool EstimateNormals(
           double queried = first;
           // The near part of the list, once (a copy: the list may be cut or queried again below): the k nearest
           // and the outliers' small neighbourhood lie in it. When it is narrower than the list, from a query of its
-          // own (a few cells: a pass over the wide list cost more), a little wider since its radius squared may
-          // round below nearLimit2, then cut exactly: the list's points within sqrt(nearLimit2), in its order.
+          // own (a few cells: a pass over the wide list cost more, also fused into the wide query's filter), a little
+          // wider since its radius squared may round below nearLimit2, then cut exactly: the list's points within
+          // sqrt(nearLimit2), in its order.
           if (!(first > 0.0 && nearLimit2 < first * first))
           {
             mine.Small.assign(pos.begin(), pos.end());
