@@ -159,6 +159,16 @@ __attribute__((target("avx2"))) void CovarianceSumsAvx2(const double* sorted, co
 }
 #endif
 
+/// A hint that the cache line of p will be written soon (no effect on results).
+inline void PrefetchForWrite(const void* p)
+{
+#if defined(__GNUC__)
+  __builtin_prefetch(p, 1, 3);
+#else
+  (void)p;
+#endif
+}
+
 /// Whether the fits' sums use the AVX2 kernels (SetNormalKernelsVectorized).
 bool CpuHasAvx2()
 {
@@ -1171,6 +1181,25 @@ bool EstimateNormals(
         for (Index s = begin + b0; s < begin + b1; ++s)
         {
           const Index id = order[s];
+          if (s + 1 < begin + b1)
+          {
+            // The next point's outputs, written by original index (a cache miss each, which stalled the stores
+            // at the end of a point): fetched for writing while this point is estimated.
+            const Index next = order[s + 1];
+            PrefetchForWrite(&field.Graph[static_cast<size_t>(next) * degree]);
+            PrefetchForWrite(&field.Graph[static_cast<size_t>(next) * degree + degree - 1]);
+            PrefetchForWrite(&field.Normals[3 * next]);
+            PrefetchForWrite(&field.Normals[3 * next + 2]);
+            PrefetchForWrite(&field.NeighborDistance[next]);
+            PrefetchForWrite(&field.Residual[next]);
+            PrefetchForWrite(&field.SurfaceVariation[next]);
+            PrefetchForWrite(&field.Radii[next]);
+            PrefetchForWrite(&field.Valid[next]);
+            if (options.MeanCurvature)
+            {
+              PrefetchForWrite(&field.MeanCurvature[next]);
+            }
+          }
           if (!IsOwn(d, id))
           {
             continue; // a halo point: its owner estimates it
