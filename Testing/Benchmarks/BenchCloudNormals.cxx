@@ -1,7 +1,7 @@
 // Meshless Normals' core (ComputeCloudNormals) on bench_scale.py's scan-like cloud, without VTK: the time of
 // its stages and a digest of every output array's bits (to check that a speed-up leaves the results unchanged).
 // Usage: BenchCloudNormals [--points N] [--repeat R] [--curvature 0|1] [--shuffle 0|1] [--full 0|1] [--wide 0|1]
-//        [--support RADIUS] [--xyz CLOUD.xyz] [--noise FRACTION] [--accuracy 0|1]
+//        [--support RADIUS] [--xyz CLOUD.xyz] [--noise FRACTION] [--accuracy 0|1] [--vector 0|1]
 // The cloud: a sphere (radius 0.5) inside a torus (R = 1, r = 0.25), points spread evenly over their area, each
 // moved along its normal by Gaussian noise of 0.1 % of the bounding box's diagonal (bench_scale.py's formula;
 // libm's log/cos may differ from numpy's in the last bit). --xyz reads "x y z" lines instead. --shuffle 1 permutes
@@ -12,6 +12,8 @@
 // --noise: sigma as a fraction of the diagonal (default 0.001). --accuracy 1: the Curvature's relative error against
 // the exact mean curvature (sphere 1 / rs; torus (R + 2 r cos v) / (2 r (R + r cos v))), mean / p99 / max, separately
 // on the sphere and the torus (points with Curvature 0 or an invalid normal count as error 1).
+// --vector 0: the portable code instead of the vector kernels (the grid's distance filter and the fits' sums):
+// the digest must not change.
 #include "Common/NeighborGrid.h"
 #include "Common/Parallel.h"
 #include "Surface/CloudNormals.h"
@@ -198,6 +200,11 @@ int main(int argc, char** argv)
     else if (key == "--accuracy")
     {
       accuracy = value != "0";
+    }
+    else if (key == "--vector")
+    {
+      meshfree::NeighborGrid::SetVectorized(value != "0");
+      meshfree::SetNormalKernelsVectorized(value != "0");
     }
     else if (key == "--xyz")
     {

@@ -850,3 +850,33 @@ TEST(NeighborGrid, FindDuplicatesGroupsEqualCoordinatesOnly)
   EXPECT_EQ(grid.FindDuplicates(rep), 0);
   EXPECT_EQ(rep, std::vector<Index>{ -1 });
 }
+
+TEST(NeighborGrid, RadiusQueryIntoBuffersListsAsTheVectorQuery)
+{
+  // FindWithinRadiusPositions into detail::Buffer (the filter writes straight into the output, growing it batch by
+  // batch) lists the same positions and squared distances in the same order as the std::vector query; radii from
+  // none to thousands of points (many batches of the filter, and growth of reused buffers), empty buffers reused.
+  const Cloud c = Uniform(20000, 41);
+  NeighborGrid grid;
+  ASSERT_TRUE(grid.Build(c.data(), Count(c)));
+  const Cloud queries = Queries(c, 500, 20, 42);
+  std::vector<Index> pos;
+  std::vector<double> d2;
+  meshfree::detail::Buffer<Index> bufferPos;
+  meshfree::detail::Buffer<double> bufferD2;
+  size_t largest = 0;
+  for (const double radius : { 0.0, 0.01, 0.05, 0.2, 0.45, 0.03 })
+  {
+    for (size_t q = 0; q + 3 <= queries.size(); q += 3)
+    {
+      grid.FindWithinRadiusPositions(&queries[q], radius, pos, d2);
+      grid.FindWithinRadiusPositions(&queries[q], radius, bufferPos, bufferD2);
+      ASSERT_EQ(bufferPos.size(), pos.size());
+      ASSERT_EQ(bufferD2.size(), d2.size());
+      EXPECT_TRUE(std::equal(pos.begin(), pos.end(), bufferPos.begin()));
+      EXPECT_TRUE(std::equal(d2.begin(), d2.end(), bufferD2.begin()));
+      largest = std::max(largest, pos.size());
+    }
+  }
+  EXPECT_GT(largest, 5000u); // many filter batches in one query
+}

@@ -177,6 +177,10 @@ public:
   /// sorted order read it contiguously.
   void FindWithinRadiusPositions(
     const double x[3], double radius, std::vector<Index>& positions, std::vector<double>& dist2) const;
+  /// As FindWithinRadiusPositions(), filtered straight into the buffers (resized to the count; no copy through a
+  /// scratch buffer, no fill when they grow).
+  void FindWithinRadiusPositions(const double x[3], double radius, detail::Buffer<Index>& positions,
+    detail::Buffer<double>& dist2) const;
   /// As FindWithinRadius(), sorted ascending in the neighbour order (NeighborBefore()).
   void FindWithinRadiusSorted(
     const double x[3], double radius, std::vector<Index>& ids, std::vector<double>& dist2) const;
@@ -243,6 +247,11 @@ private:
   void ChooseGrid(double cellSize, Index validPoints);
   template <class Visit>
   void VisitCells(const double rel[3], const Index cell[3], double radius, Visit&& visit) const;
+  /// The radius filter: batches of at most FilterBatch candidates, each filtered into the buffers room(candidates,
+  /// dist2, pos) points to (room for candidates + 8 entries), then accept(found, dist2, pos).
+  static constexpr Index FilterBatch = 248;
+  template <class Room, class Accept>
+  void FilterRadiusTo(const double x[3], double radius, Room&& room, Accept&& accept) const;
   template <class Accept>
   void FilterRadius(const double x[3], double radius, Accept&& accept) const;
   int NearestWithinEstimate(const double x[3], const double rel[3], const Index cell[3], int k,

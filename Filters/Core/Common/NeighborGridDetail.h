@@ -206,8 +206,8 @@ inline void NeighborGrid::VisitCells(const double rel[3], const Index cq[3], dou
   }
 }
 
-template <class Accept>
-inline void NeighborGrid::FilterRadius(const double x[3], double radius, Accept&& accept) const
+template <class Room, class Accept>
+inline void NeighborGrid::FilterRadiusTo(const double x[3], double radius, Room&& room, Accept&& accept) const
 {
   double rel[3];
   Index cq[3];
@@ -219,15 +219,15 @@ inline void NeighborGrid::FilterRadius(const double x[3], double radius, Accept&
   const double* xyz = this->Sorted.data();
   // Cell ranges are batched (neighbouring ranges merged) so that one filter call handles many cells.
   constexpr int MaxRanges = 32;
-  constexpr Index MaxPoints = 248;
   CellRange ranges[MaxRanges];
   int rangeCount = 0;
   Index points = 0;
-  double dist2[MaxPoints + 8];
-  Index pos[MaxPoints + 8];
   auto flush = [&] {
     if (rangeCount > 0)
     {
+      double* dist2 = nullptr;
+      Index* pos = nullptr;
+      room(points, dist2, pos);
       const int found = grid_detail::Filter(xyz, ranges, rangeCount, x, r2, dist2, pos);
       accept(found, dist2, pos);
     }
@@ -237,11 +237,11 @@ inline void NeighborGrid::FilterRadius(const double x[3], double radius, Accept&
   this->VisitCells(rel, cq, radius, [&](const CellRange& cell) {
     for (Index b = cell.Begin; b < cell.End;)
     {
-      if (points == MaxPoints)
+      if (points == FilterBatch)
       {
         flush();
       }
-      const Index e = std::min(cell.End, b + (MaxPoints - points));
+      const Index e = std::min(cell.End, b + (FilterBatch - points));
       if (rangeCount > 0 && ranges[rangeCount - 1].End == b)
       {
         ranges[rangeCount - 1].End = e;
@@ -260,6 +260,20 @@ inline void NeighborGrid::FilterRadius(const double x[3], double radius, Accept&
     return true;
   });
   flush();
+}
+
+template <class Accept>
+inline void NeighborGrid::FilterRadius(const double x[3], double radius, Accept&& accept) const
+{
+  double dist2[FilterBatch + 8];
+  Index pos[FilterBatch + 8];
+  this->FilterRadiusTo(
+    x, radius,
+    [&](Index, double*& d2, Index*& p) {
+      d2 = dist2;
+      p = pos;
+    },
+    accept);
 }
 } // namespace meshfree
 

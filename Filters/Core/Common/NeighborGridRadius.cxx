@@ -106,6 +106,29 @@ void NeighborGrid::FindWithinRadiusPositions(
   });
 }
 
+void NeighborGrid::FindWithinRadiusPositions(
+  const double x[3], double radius, detail::Buffer<Index>& positions, detail::Buffer<double>& dist2) const
+{
+  size_t count = 0;
+  positions.clear();
+  dist2.clear();
+  this->FilterRadiusTo(
+    x, radius,
+    [&](Index candidates, double*& d2, Index*& pos) {
+      const size_t room = count + static_cast<size_t>(candidates) + 8;
+      if (positions.size() < room)
+      {
+        positions.resize(std::max(room, 2 * positions.size()));
+        dist2.resize(positions.size());
+      }
+      d2 = dist2.data() + count;
+      pos = positions.data() + count;
+    },
+    [&](int found, const double*, const Index*) { count += static_cast<size_t>(found); });
+  positions.resize(count);
+  dist2.resize(count);
+}
+
 void NeighborGrid::FindWithinRadiusSorted(
   const double x[3], double radius, std::vector<Index>& ids, std::vector<double>& dist2) const
 {

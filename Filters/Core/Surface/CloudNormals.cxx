@@ -74,10 +74,12 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
   const Index nv = static_cast<Index>(order.size());
   const int degree = field.GraphDegree;
   std::vector<std::int32_t> rank(static_cast<size_t>(n), -1);
-  for (Index s = 0; s < nv; ++s)
-  {
-    rank[order[s]] = static_cast<std::int32_t>(s);
-  }
+  ParallelFor(nv, 4096, [&](Index b0, Index b1) {
+    for (Index s = b0; s < b1; ++s)
+    {
+      rank[order[s]] = static_cast<std::int32_t>(s);
+    }
+  });
   // Per sorted position: the value signed along the oriented normal, and the neighbours that take part.
   std::vector<double> k(static_cast<size_t>(nv), 0.0), next(static_cast<size_t>(nv), 0.0);
   std::vector<std::int32_t> graph(static_cast<size_t>(nv) * degree, -1);
@@ -133,10 +135,12 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
     }
   }
   curvature.assign(static_cast<size_t>(n), 0.0);
-  for (Index s = 0; s < nv; ++s)
-  {
-    curvature[order[s]] = field.Valid[order[s]] ? k[s] : 0.0;
-  }
+  ParallelFor(nv, 4096, [&](Index b0, Index b1) {
+    for (Index s = b0; s < b1; ++s)
+    {
+      curvature[order[s]] = field.Valid[order[s]] ? k[s] : 0.0;
+    }
+  });
 }
 } // namespace
 

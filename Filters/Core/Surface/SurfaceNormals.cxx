@@ -10,8 +10,14 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <vector>
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define MESHFREE_NORMALS_AVX2 1 // the fits' sums with AVX2, chosen at run time (SetNormalKernelsVectorized)
+#endif
 
 namespace meshfree
 {
@@ -96,20 +102,17 @@ inline Pair operator*(const Pair& a, const Pair& b)
 }
 #endif
 
-/// The mean offset (mean[3]) and the covariance's eigen-decomposition of `count` points given by point(m), in
-/// coordinates shifted to x and scaled by inv (|d| <= 1): one pass of first and second moments,
-/// C = E[d d^T] - E[d] E[d]^T. False when the points span no plane (collinear or coincident: the closed-form
-/// solver's eigenvalues are accurate to ~1e-9 of the largest, so a relative width below 1e-3 counts as a line).
-template <class Point>
-bool ScaledCovariance(size_t count, const Point& point, const double x[3], double inv, double mean[3],
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig)
+/// The first and second moments of the points sorted + 3 idx[m] (m < count) in coordinates shifted to x and scaled
+/// by inv: m1 = sum d, m2 = sum (xx, xy, xz, yy, yz, zz), each summed in the points' order.
+void CovarianceSums(const double* sorted, const Index* idx, size_t count, const double x[3], double inv, double m1[3],
+  double m2[6])
 {
   // The sums in pairs (Pair: each lane one sum's products and additions, in the points' order).
   Pair m1xy = { 0.0, 0.0 }, m2xx_xy = m1xy, m2xz_yz = m1xy, m2yy_zz = m1xy;
   double m1z = 0.0;
   for (size_t m = 0; m < count; ++m)
   {
-    const double* p = point(m);
+    const double* p = sorted + 3 * idx[m];
     const double d0 = (p[0] - x[0]) * inv, d1 = (p[1] - x[1]) * inv, d2 = (p[2] - x[2]) * inv;
     const Pair xy = { d0, d1 }, yz = { d1, d2 };
     m1xy += xy;
@@ -118,8 +121,84 @@ bool ScaledCovariance(size_t count, const Point& point, const double x[3], doubl
     m2xz_yz += d2 * xy;
     m2yy_zz += yz * yz;
   }
-  const double m1[3] = { m1xy[0], m1xy[1], m1z };
-  const double m2[6] = { m2xx_xy[0], m2xx_xy[1], m2xz_yz[0], m2yy_zz[0], m2xz_yz[1], m2yy_zz[1] }; // xx xy xz yy yz zz
+  m1[0] = m1xy[0];
+  m1[1] = m1xy[1];
+  m1[2] = m1z;
+  const double sums[6] = { m2xx_xy[0], m2xx_xy[1], m2xz_yz[0], m2yy_zz[0], m2xz_yz[1], m2yy_zz[1] };
+  std::copy(sums, sums + 6, m2);
+}
+
+#ifdef MESHFREE_NORMALS_AVX2
+/// CovarianceSums with AVX2 (no FMA in the target: every product and sum is rounded as in the portable code, and
+/// each lane sums in the points' order, so the bits are the same): d = (d0, d1, d2, 0) in one register.
+__attribute__((target("avx2"))) void CovarianceSumsAvx2(const double* sorted, const Index* idx, size_t count,
+  const double x[3], double inv, double m1[3], double m2[6])
+{
+  const __m256i three = _mm256_set_epi64x(0, -1, -1, -1);
+  const __m256d origin = _mm256_maskload_pd(x, three), scale = _mm256_set1_pd(inv);
+  __m256d first = _mm256_setzero_pd(), second = first, rest = first;
+  for (size_t m = 0; m < count; ++m)
+  {
+    const __m256d d = _mm256_mul_pd(_mm256_sub_pd(_mm256_maskload_pd(sorted + 3 * idx[m], three), origin), scale);
+    first = _mm256_add_pd(first, d);
+    // (d0 d0, d0 d1, d0 d2, d1 d1) and (d1 d2, d2 d2, 0, 0).
+    second = _mm256_add_pd(second,
+      _mm256_mul_pd(_mm256_permute4x64_pd(d, 0x40), _mm256_permute4x64_pd(d, 0x64)));
+    rest = _mm256_add_pd(rest, _mm256_mul_pd(_mm256_permute4x64_pd(d, 0xF9), _mm256_permute4x64_pd(d, 0xFA)));
+  }
+  alignas(32) double a[4], b[4], c[4];
+  _mm256_store_pd(a, first);
+  _mm256_store_pd(b, second);
+  _mm256_store_pd(c, rest);
+  for (int k = 0; k < 3; ++k)
+  {
+    m1[k] = a[k];
+  }
+  const double sums[6] = { b[0], b[1], b[2], b[3], c[0], c[1] };
+  std::copy(sums, sums + 6, m2);
+}
+#endif
+
+/// A hint that the cache line of p will be written soon (no effect on results).
+inline void PrefetchForWrite(const void* p)
+{
+#if defined(__GNUC__)
+  __builtin_prefetch(p, 1, 3);
+#else
+  (void)p;
+#endif
+}
+
+/// Whether the fits' sums use the AVX2 kernels (SetNormalKernelsVectorized).
+bool CpuHasAvx2()
+{
+#ifdef MESHFREE_NORMALS_AVX2
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+std::atomic<bool> VectorKernels{ CpuHasAvx2() };
+
+/// The mean offset (mean[3]) and the covariance's eigen-decomposition of the `count` points sorted + 3 idx[m], in
+/// coordinates shifted to x and scaled by inv (|d| <= 1): one pass of first and second moments,
+/// C = E[d d^T] - E[d] E[d]^T. False when the points span no plane (collinear or coincident: the closed-form
+/// solver's eigenvalues are accurate to ~1e-9 of the largest, so a relative width below 1e-3 counts as a line).
+bool ScaledCovariance(const double* sorted, const Index* idx, size_t count, const double x[3], double inv,
+  double mean[3], Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig)
+{
+  double m1[3], m2[6]; // xx xy xz yy yz zz
+#ifdef MESHFREE_NORMALS_AVX2
+  if (VectorKernels.load(std::memory_order_relaxed))
+  {
+    CovarianceSumsAvx2(sorted, idx, count, x, inv, m1, m2);
+  }
+  else
+#endif
+  {
+    CovarianceSums(sorted, idx, count, x, inv, m1, m2);
+  }
   const double w = 1.0 / static_cast<double>(count);
   for (int a = 0; a < 3; ++a)
   {
@@ -149,7 +228,7 @@ LocalPCA PrincipalAxes(const double* sorted, const Index* pos, size_t count, con
   const double inv = 1.0 / scale;
   double m1[3];
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  if (!ScaledCovariance(count, [&](size_t j) { return sorted + 3 * pos[j]; }, x, inv, m1, eig))
+  if (!ScaledCovariance(sorted, pos, count, x, inv, m1, eig))
   {
     return out;
   }
@@ -219,6 +298,161 @@ void SpreadSubset(const Index* pos, size_t count, size_t used, Index* picked)
   }
 }
 
+/// The sums of a jet's least squares (FitJet) in the frame (e1, e2, e3) = (t1, t2, n): over the points whose
+/// scaled offset d = (p - x) inv is not zero, with u = d.e1, v = d.e2, h = d.e3 and q = h^2 / 2, each summed in the
+/// points' order: U the monomials 1 u v uu uv vv uuu uuv uvv vvv uuuu uuuv uuvv uvvv vvvv (U[0] the count), H the
+/// products h (1 u v uu uv vv), HH = sum h h and, WithCurvature, Q = sums of q, hq, uq, vq, uuq, uvq, vvq, qq.
+struct JetSums
+{
+  double U[15] = {};
+  double H[6] = {};
+  double HH = 0.0;
+  double Q[8] = {};
+  size_t Fitted = 0;
+};
+
+template <bool WithCurvature>
+void AccumulateJet(const double* sorted, const Index* picked, size_t used, const double x[3], double inv,
+  const double e1[3], const double e2[3], const double e3[3], JetSums& out)
+{
+  size_t fitted = 0;
+  // Pairs of the sums side by side (each lane the products and additions of one sum, in the order of the list:
+  // the bits of a scalar loop, in about half the instructions).
+  const Pair f0 = { e1[0], e2[0] }, f1 = { e1[1], e2[1] }, f2 = { e1[2], e2[2] };
+  Pair s12 = { 0.0, 0.0 }, s34 = s12, s67 = s12, s89 = s12, s1011 = s12, s1213 = s12, h12 = s12, h34 = s12,
+       h5h = s12;
+  double s5 = 0.0, s14 = 0.0, h0 = 0.0;
+  // The curvature jet's extra sums, of q = h^2 / 2: (q, hq), (uq, vq), (uuq, uvq), (vvq, qq).
+  Pair q1 = { 0.0, 0.0 }, q2 = q1, q3 = q1, q4 = q1;
+  for (size_t m = 0; m < used; ++m)
+  {
+    const double* p = sorted + 3 * picked[m];
+    const double d0 = (p[0] - x[0]) * inv, d1 = (p[1] - x[1]) * inv, d2 = (p[2] - x[2]) * inv;
+    if (d0 == 0.0 && d1 == 0.0 && d2 == 0.0)
+    {
+      continue;
+    }
+    const Pair uv2 = d0 * f0 + d1 * f1 + d2 * f2; // (u, v)
+    const double u = uv2[0], v = uv2[1];
+    const double h = d0 * e3[0] + d1 * e3[1] + d2 * e3[2];
+    const Pair quad = u * uv2; // (uu, uv)
+    const double uu = quad[0], vv = v * v;
+    s12 += uv2;
+    s34 += quad;
+    s5 += vv;
+    s67 += uu * uv2;    // (uuu, uuv)
+    s89 += vv * uv2;    // (uvv, vvv)
+    s1011 += uu * quad; // (uuuu, uuuv)
+    s1213 += vv * quad; // (uuvv, uvvv)
+    s14 += vv * vv;
+    h0 += h;
+    h12 += h * uv2;
+    h34 += h * quad;
+    const Pair vh = { vv, h };
+    h5h += h * vh; // (h vv, h h)
+    if constexpr (WithCurvature)
+    {
+      const double q = 0.5 * h * h;
+      const Pair one_h = { 1.0, h }, vv_q = { vv, q };
+      q1 += q * one_h;
+      q2 += q * uv2;
+      q3 += q * quad;
+      q4 += q * vv_q;
+    }
+    ++fitted;
+  }
+  const double u[15] = { static_cast<double>(fitted), s12[0], s12[1], s34[0], s34[1], s5, s67[0], s67[1], s89[0],
+    s89[1], s1011[0], s1011[1], s1213[0], s1213[1], s14 };
+  const double h[6] = { h0, h12[0], h12[1], h34[0], h34[1], h5h[0] };
+  const double q[8] = { q1[0], q1[1], q2[0], q2[1], q3[0], q3[1], q4[0], q4[1] };
+  std::copy(u, u + 15, out.U);
+  std::copy(h, h + 6, out.H);
+  std::copy(q, q + 8, out.Q);
+  out.HH = h5h[1];
+  out.Fitted = fitted;
+}
+
+#ifdef MESHFREE_NORMALS_AVX2
+/// AccumulateJet with AVX2, the same bits: no FMA in the target (every product and sum rounded as in the portable
+/// code), each lane one sum, in the points' order, of the same products (IEEE products commute). Per point
+/// t = (u, v, h, 0) = (d0 E0 + d1 E1) + d2 E2 as the portable code sums it, s = (uu, uv, vv, q) with
+/// q = (0.5 h) h, and six (eight with the curvature) lanes of four sums each.
+template <bool WithCurvature>
+__attribute__((target("avx2"))) void AccumulateJetAvx2(const double* sorted, const Index* picked, size_t used,
+  const double x[3], double inv, const double e1[3], const double e2[3], const double e3[3], JetSums& out)
+{
+  const __m256d x0 = _mm256_set1_pd(x[0]), x1 = _mm256_set1_pd(x[1]), x2 = _mm256_set1_pd(x[2]);
+  const __m256d scale = _mm256_set1_pd(inv);
+  const __m256d f0 = _mm256_set_pd(0.0, e3[0], e2[0], e1[0]), f1 = _mm256_set_pd(0.0, e3[1], e2[1], e1[1]),
+                f2 = _mm256_set_pd(0.0, e3[2], e2[2], e1[2]);
+  const __m256d halve = _mm256_set_pd(0.5, 1.0, 1.0, 1.0);
+  const __m256i magnitude = _mm256_set1_epi64x(0x7FFFFFFFFFFFFFFFLL);
+  __m256d linear = _mm256_setzero_pd(); // u v h -
+  __m256d quadratic = linear;           // uu uv vv q
+  __m256d cubic = linear;               // uuu uuv uvv vvv
+  __m256d quartic = linear;             // uuuu uuuv uuvv uvvv
+  __m256d heights = linear;             // hu hv huu huv
+  __m256d mixed = linear;               // vvvv hvv hh hq
+  __m256d curved = linear;              // qu qv quu quv
+  __m256d squares = linear;             // qvv qq - -
+  size_t fitted = 0;
+  for (size_t m = 0; m < used; ++m)
+  {
+    const double* p = sorted + 3 * picked[m];
+    const __m256d d0 = _mm256_mul_pd(_mm256_sub_pd(_mm256_broadcast_sd(p), x0), scale);
+    const __m256d d1 = _mm256_mul_pd(_mm256_sub_pd(_mm256_broadcast_sd(p + 1), x1), scale);
+    const __m256d d2 = _mm256_mul_pd(_mm256_sub_pd(_mm256_broadcast_sd(p + 2), x2), scale);
+    // All three zero (either sign): the point itself or a duplicate, not fitted.
+    if (_mm256_testz_si256(_mm256_castpd_si256(_mm256_or_pd(_mm256_or_pd(d0, d1), d2)), magnitude))
+    {
+      continue;
+    }
+    const __m256d t =
+      _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, f0), _mm256_mul_pd(d1, f1)), _mm256_mul_pd(d2, f2));
+    // (u, u, v, h) (1, 1, 1, 0.5) (u, v, v, h)
+    const __m256d s = _mm256_mul_pd(_mm256_mul_pd(_mm256_permute4x64_pd(t, 0x90), halve),
+      _mm256_permute4x64_pd(t, 0x94));
+    linear = _mm256_add_pd(linear, t);
+    quadratic = _mm256_add_pd(quadratic, s);
+    const __m256d uuvv = _mm256_permute_pd(s, 0x0);          // uu uu vv vv
+    const __m256d uv = _mm256_permute2f128_pd(t, t, 0x00);   // u v u v
+    const __m256d quad = _mm256_permute2f128_pd(s, s, 0x00); // uu uv uu uv
+    cubic = _mm256_add_pd(cubic, _mm256_mul_pd(uuvv, uv));
+    quartic = _mm256_add_pd(quartic, _mm256_mul_pd(uuvv, quad));
+    const __m256d lowTerms = _mm256_permute2f128_pd(t, s, 0x20); // u v uu uv
+    heights = _mm256_add_pd(heights, _mm256_mul_pd(_mm256_permute4x64_pd(t, 0xAA), lowTerms));
+    const __m256d tail = _mm256_permute2f128_pd(s, t, 0x31); // vv q h 0
+    // (vv, vv, h, h) (vv, h, h, q)
+    mixed = _mm256_add_pd(mixed, _mm256_mul_pd(_mm256_permute_pd(tail, 0x0), _mm256_permute4x64_pd(tail, 0x68)));
+    if constexpr (WithCurvature)
+    {
+      const __m256d q = _mm256_permute4x64_pd(s, 0xFF);
+      curved = _mm256_add_pd(curved, _mm256_mul_pd(q, lowTerms));
+      squares = _mm256_add_pd(squares, _mm256_mul_pd(q, tail));
+    }
+    ++fitted;
+  }
+  alignas(32) double a[8][4];
+  _mm256_store_pd(a[0], linear);
+  _mm256_store_pd(a[1], quadratic);
+  _mm256_store_pd(a[2], cubic);
+  _mm256_store_pd(a[3], quartic);
+  _mm256_store_pd(a[4], heights);
+  _mm256_store_pd(a[5], mixed);
+  _mm256_store_pd(a[6], curved);
+  _mm256_store_pd(a[7], squares);
+  const double u[15] = { static_cast<double>(fitted), a[0][0], a[0][1], a[1][0], a[1][1], a[1][2], a[2][0], a[2][1],
+    a[2][2], a[2][3], a[3][0], a[3][1], a[3][2], a[3][3], a[5][0] };
+  const double h[6] = { a[0][2], a[4][0], a[4][1], a[4][2], a[4][3], a[5][1] };
+  const double q[8] = { a[1][3], a[5][3], a[6][0], a[6][1], a[6][2], a[6][3], a[7][0], a[7][1] };
+  std::copy(u, u + 15, out.U);
+  std::copy(h, h + 6, out.H);
+  std::copy(q, q + 8, out.Q);
+  out.HH = a[5][2];
+  out.Fitted = fitted;
+}
+#endif
+
 /// A degree-2 jet (Cazals & Pouget 2005) over up to MaxFit of the points at sorted positions pos[0..count)
 /// (a subset spread evenly over the list when there are more: the list is in cell order, so the subset is
 /// spread over the neighbourhood and depends only on the positions), in coordinates shifted to x and scaled
@@ -244,16 +478,14 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
   const size_t used = std::min(count, MaxFit);
   Index picked[MaxFit];
   SpreadSubset(pos, count, used, picked);
-  auto at = [&](size_t m) { return sorted + 3 * picked[m]; };
   // The frame (PCA) from fewer points still: the jet corrects its tilt.
   const size_t framed = std::min(used, FramePoints);
   Index framePicked[FramePoints];
   SpreadSubset(pos, count, framed, framePicked);
-  auto frameAt = [&](size_t m) { return sorted + 3 * framePicked[m]; };
   const double inv = 1.0 / scale;
   double m1[3];
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  if (!ScaledCovariance(framed, frameAt, x, inv, m1, eig))
+  if (!ScaledCovariance(sorted, framePicked, framed, x, inv, m1, eig))
   {
     return out; // collinear or coincident: no plane
   }
@@ -265,78 +497,22 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
   if (used >= 12)
   {
     // Moments of the basis b = (1, u, v, u^2, uv, v^2): sums of u^i v^j up to i + j = 4, and of h b.
-    double su[15] = {}; // 1 u v uu uv vv uuu uuv uvv vvv uuuu uuuv uuvv uvvv vvvv
-    double sh[6] = {};
-    double hh = 0.0;
-    size_t fitted = 0;
     const double e1[3] = { t1(0), t1(1), t1(2) }, e2[3] = { t2(0), t2(1), t2(2) }, e3[3] = { n(0), n(1), n(2) };
-    // Pairs of the sums side by side (each lane the products and additions of one sum, in the order of the list:
-    // the bits of a scalar loop, in about half the instructions).
-    const Pair f0 = { e1[0], e2[0] }, f1 = { e1[1], e2[1] }, f2 = { e1[2], e2[2] };
-    Pair s12 = { 0.0, 0.0 }, s34 = s12, s67 = s12, s89 = s12, s1011 = s12, s1213 = s12, h12 = s12, h34 = s12,
-         h5h = s12;
-    double s5 = 0.0, s14 = 0.0, h0 = 0.0;
-    // The curvature jet's extra sums, of q = h^2 / 2: (q, hq), (uq, vq), (uuq, uvq), (vvq, qq).
-    Pair q1 = { 0.0, 0.0 }, q2 = q1, q3 = q1, q4 = q1;
-    for (size_t m = 0; m < used; ++m)
+    JetSums sums;
+#ifdef MESHFREE_NORMALS_AVX2
+    if (VectorKernels.load(std::memory_order_relaxed))
     {
-      const double* p = at(m);
-      const double d0 = (p[0] - x[0]) * inv, d1 = (p[1] - x[1]) * inv, d2 = (p[2] - x[2]) * inv;
-      if (d0 == 0.0 && d1 == 0.0 && d2 == 0.0)
-      {
-        continue;
-      }
-      const Pair uv2 = d0 * f0 + d1 * f1 + d2 * f2; // (u, v)
-      const double u = uv2[0], v = uv2[1];
-      const double h = d0 * e3[0] + d1 * e3[1] + d2 * e3[2];
-      const Pair quad = u * uv2; // (uu, uv)
-      const double uu = quad[0], vv = v * v;
-      s12 += uv2;
-      s34 += quad;
-      s5 += vv;
-      s67 += uu * uv2;    // (uuu, uuv)
-      s89 += vv * uv2;    // (uvv, vvv)
-      s1011 += uu * quad; // (uuuu, uuuv)
-      s1213 += vv * quad; // (uuvv, uvvv)
-      s14 += vv * vv;
-      h0 += h;
-      h12 += h * uv2;
-      h34 += h * quad;
-      const Pair vh = { vv, h };
-      h5h += h * vh; // (h vv, h h)
-      if constexpr (WithCurvature)
-      {
-        const double q = 0.5 * h * h;
-        const Pair one_h = { 1.0, h }, vv_q = { vv, q };
-        q1 += q * one_h;
-        q2 += q * uv2;
-        q3 += q * quad;
-        q4 += q * vv_q;
-      }
-      ++fitted;
+      AccumulateJetAvx2<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, sums);
     }
-    su[1] = s12[0];
-    su[2] = s12[1];
-    su[3] = s34[0];
-    su[4] = s34[1];
-    su[5] = s5;
-    su[6] = s67[0];
-    su[7] = s67[1];
-    su[8] = s89[0];
-    su[9] = s89[1];
-    su[10] = s1011[0];
-    su[11] = s1011[1];
-    su[12] = s1213[0];
-    su[13] = s1213[1];
-    su[14] = s14;
-    sh[0] = h0;
-    sh[1] = h12[0];
-    sh[2] = h12[1];
-    sh[3] = h34[0];
-    sh[4] = h34[1];
-    sh[5] = h5h[0];
-    hh = h5h[1];
-    su[0] = static_cast<double>(fitted);
+    else
+#endif
+    {
+      AccumulateJet<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, sums);
+    }
+    const double* su = sums.U; // 1 u v uu uv vv uuu uuv uvv vvv uuuu uuuv uuvv uvvv vvvv
+    const double* sh = sums.H;
+    const double hh = sums.HH;
+    const size_t fitted = sums.Fitted;
     // M(i, j) = sum b_i b_j: the monomial of b_i times b_j.
     static constexpr int Product[6][6] = { { 0, 1, 2, 3, 4, 5 }, { 1, 3, 4, 6, 7, 8 }, { 2, 4, 5, 7, 8, 9 },
       { 3, 6, 7, 10, 11, 12 }, { 4, 7, 8, 11, 12, 13 }, { 5, 8, 9, 12, 13, 14 } };
@@ -369,8 +545,8 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
       if constexpr (WithCurvature)
       {
         // The basis (1, u, v, U, uv, W), U = uu + q, W = vv + q: its moments from the plain ones and q's.
-        const double sq = q1[0], shq = q1[1], suq = q2[0], svq = q2[1], suuq = q3[0], suvq = q3[1], svvq = q4[0],
-                     sqq = q4[1];
+        const double sq = sums.Q[0], shq = sums.Q[1], suq = sums.Q[2], svq = sums.Q[3], suuq = sums.Q[4],
+                     suvq = sums.Q[5], svvq = sums.Q[6], sqq = sums.Q[7];
         Eigen::Matrix<double, 6, 6> C = moments;
         C(0, 3) += sq;
         C(0, 5) += sq;
@@ -458,10 +634,40 @@ bool NearestOfList(const double* sorted, const Index* pos, const double* r2, siz
   {
     return false;
   }
-  std::nth_element(keys.begin(), keys.begin() + (k - 1), keys.begin() + static_cast<std::ptrdiff_t>(kept2));
-  kth = std::sqrt(keys[k - 1]);
+  // The k-th smallest is the (kept2 - k + 1)-th largest: usually few (the first bound holds a little more than k),
+  // kept sorted by insertion, which is cheaper than a selection over all of them.
+  constexpr size_t MaxLargest = 16;
+  const size_t largest = kept2 - static_cast<size_t>(k) + 1;
+  double kth2;
+  if (largest <= MaxLargest)
+  {
+    double top[MaxLargest]; // descending
+    size_t held = 0;
+    for (size_t j = 0; j < kept2; ++j)
+    {
+      const double v = keys[j];
+      if (held == largest && !(v > top[largest - 1]))
+      {
+        continue;
+      }
+      size_t at = held < largest ? held++ : largest - 1;
+      while (at > 0 && top[at - 1] < v)
+      {
+        top[at] = top[at - 1];
+        --at;
+      }
+      top[at] = v;
+    }
+    kth2 = top[largest - 1];
+  }
+  else
+  {
+    std::nth_element(keys.begin(), keys.begin() + (k - 1), keys.begin() + static_cast<std::ptrdiff_t>(kept2));
+    kth2 = keys[k - 1];
+  }
+  kth = std::sqrt(kth2);
   // The degree <= k nearest lie within the k-th distance.
-  limit2 = keys[k - 1];
+  limit2 = kth2;
   // The `degree` first in the neighbour order, kept sorted by insertion (degree is small).
   constexpr int MaxDegree = 64;
   const int want = std::min(std::min(degree, k), MaxDegree);
@@ -634,32 +840,39 @@ void FlagOutliers(NormalField& field, const Distribution* d)
   const double threshold =
     std::max(6.0 * GlobalMedian(d, std::move(residuals)), 0.05 * GlobalMedian(d, std::move(distances)));
   const int k = field.GraphDegree;
-  for (size_t i = 0; i < n; ++i)
-  {
-    if (!field.Valid[i] || !IsOwn(d, static_cast<Index>(i)))
-    {
-      continue;
-    }
-    // Isolated: its k-th neighbour three times farther than its nearest neighbours' (a sparse region of a
-    // scan has sparse neighbours too, so only points alone in their surroundings qualify).
-    double around = 0.0;
-    int counted = 0;
-    for (int j = 0; j < k; ++j)
-    {
-      const std::int32_t v = field.Graph[i * k + j];
-      if (v >= 0)
+  // In parallel: the neighbours' r_k are read by original index (cache misses).
+  field.OutlierCount += ParallelReduce(static_cast<Index>(n), 4096, Index(0),
+    [&](Index b0, Index b1) {
+      Index flagged = 0;
+      for (Index i = b0; i < b1; ++i)
       {
-        around += field.NeighborDistance[v];
-        ++counted;
+        if (!field.Valid[i] || !IsOwn(d, i))
+        {
+          continue;
+        }
+        // Isolated: its k-th neighbour three times farther than its nearest neighbours' (a sparse region of a
+        // scan has sparse neighbours too, so only points alone in their surroundings qualify).
+        double around = 0.0;
+        int counted = 0;
+        for (int j = 0; j < k; ++j)
+        {
+          const std::int32_t v = field.Graph[static_cast<size_t>(i) * k + j];
+          if (v >= 0)
+          {
+            around += field.NeighborDistance[v];
+            ++counted;
+          }
+        }
+        const bool isolated = counted > 0 && field.NeighborDistance[i] > 3.0 * around / counted;
+        if (isolated || field.Residual[i] > threshold)
+        {
+          field.Outlier[i] = 1;
+          ++flagged;
+        }
       }
-    }
-    const bool isolated = counted > 0 && field.NeighborDistance[i] > 3.0 * around / counted;
-    if (isolated || field.Residual[i] > threshold)
-    {
-      field.Outlier[i] = 1;
-      ++field.OutlierCount;
-    }
-  }
+      return flagged;
+    },
+    [](Index a, Index b) { return a + b; });
   UpdateHalo(d, field.Outlier);
 }
 
@@ -870,6 +1083,13 @@ CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& opt
   return scale;
 }
 
+bool SetNormalKernelsVectorized(bool enable)
+{
+  const bool vector = enable && CpuHasAvx2();
+  VectorKernels.store(vector);
+  return vector;
+}
+
 bool EstimateNormals(
   const NeighborGrid& grid, const NormalOptions& options, NormalField& field, const ProgressCallback& progress)
 {
@@ -938,8 +1158,10 @@ bool EstimateNormals(
   std::vector<double> rms(static_cast<size_t>(nv), 0.0), height(static_cast<size_t>(nv), 0.0);
   struct Buffers
   {
-    std::vector<Index> Ids, Positions, Small, Local;
-    std::vector<double> Dist2, Radius2, Keys, SmallD2;
+    std::vector<Index> Ids, Local;
+    std::vector<double> Dist2, Keys;
+    detail::Buffer<Index> Positions, Small;
+    detail::Buffer<double> Radius2, SmallD2;
     double Shortfall = -HUGE_VAL;
   };
   PerThread<Buffers> buffers;
@@ -950,15 +1172,34 @@ bool EstimateNormals(
       [&](Index b0, Index b1) {
         Buffers& mine = buffers.Local();
         std::vector<Index>& ids = mine.Ids;
-        std::vector<Index>& pos = mine.Positions;
+        detail::Buffer<Index>& pos = mine.Positions;
         std::vector<double>& d2 = mine.Dist2;
-        std::vector<double>& r2 = mine.Radius2;
+        detail::Buffer<double>& r2 = mine.Radius2;
         std::vector<double>& keys = mine.Keys;
         Index failed = 0;
         double& shortfall = mine.Shortfall;
         for (Index s = begin + b0; s < begin + b1; ++s)
         {
           const Index id = order[s];
+          if (s + 1 < begin + b1)
+          {
+            // The next point's outputs, written by original index (a cache miss each, which stalled the stores
+            // at the end of a point): fetched for writing while this point is estimated.
+            const Index next = order[s + 1];
+            PrefetchForWrite(&field.Graph[static_cast<size_t>(next) * degree]);
+            PrefetchForWrite(&field.Graph[static_cast<size_t>(next) * degree + degree - 1]);
+            PrefetchForWrite(&field.Normals[3 * next]);
+            PrefetchForWrite(&field.Normals[3 * next + 2]);
+            PrefetchForWrite(&field.NeighborDistance[next]);
+            PrefetchForWrite(&field.Residual[next]);
+            PrefetchForWrite(&field.SurfaceVariation[next]);
+            PrefetchForWrite(&field.Radii[next]);
+            PrefetchForWrite(&field.Valid[next]);
+            if (options.MeanCurvature)
+            {
+              PrefetchForWrite(&field.MeanCurvature[next]);
+            }
+          }
           if (!IsOwn(d, id))
           {
             continue; // a halo point: its owner estimates it
@@ -974,8 +1215,9 @@ bool EstimateNormals(
           double queried = first;
           // The near part of the list, once (a copy: the list may be cut or queried again below): the k nearest
           // and the outliers' small neighbourhood lie in it. When it is narrower than the list, from a query of its
-          // own (a few cells: a pass over the wide list cost more), a little wider since its radius squared may
-          // round below nearLimit2, then cut exactly: the list's points within sqrt(nearLimit2), in its order.
+          // own (a few cells: a pass over the wide list cost more, also fused into the wide query's filter), a little
+          // wider since its radius squared may round below nearLimit2, then cut exactly: the list's points within
+          // sqrt(nearLimit2), in its order.
           if (!(first > 0.0 && nearLimit2 < first * first))
           {
             mine.Small.assign(pos.begin(), pos.end());

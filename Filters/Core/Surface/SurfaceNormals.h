@@ -124,6 +124,11 @@ struct NormalField
 bool EstimateNormals(const NeighborGrid& grid, const NormalOptions& options, NormalField& field,
   const ProgressCallback& progress = ProgressCallback());
 
+/// The fits' sums (the jets' and the frames' moments) are accumulated with AVX2 when the CPU has it (chosen at run
+/// time; bit-identical to the portable code). SetNormalKernelsVectorized(false) forces the portable code, e.g. to
+/// compare the two; call it while no estimate runs. Returns whether the vector kernels are in use.
+bool SetNormalKernelsVectorized(bool enable);
+
 /// The scale of the cloud (also computed by EstimateNormals): spacing, noise and the radius noise asks for.
 CloudScale EstimateCloudScale(const NeighborGrid& grid, const NormalOptions& options);
 
