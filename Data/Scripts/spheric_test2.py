@@ -11,7 +11,9 @@ The column is placed on the tank's lattice (its length rounded to a whole number
 Estimators (this script's choices, recorded in the CSV header): a water height is the water depth at the gauge, the
 particles' volume dx^3 spread by a tent of half-width 2 dx in x and in y (a splash adds its volume, not its
 height); a pressure is the Shepard (kernel-weighted) average of the particle pressures within the support radius h = 2 dx
-of the probe point moved half a spacing into the fluid (x + dx/2 on the front face, z + dx/2 on the top).
+of the probe point moved half a spacing into the fluid (x + dx/2 on the front face, z + dx/2 on the top). With DFSPH
+the particle pressures are themselves averaged over the output interval (SPH Fluid's Pressure: the solves' impulses
+over the interval divided by its length), so the probes read a sensor with that bandwidth.
 
 Run from pvpython (plugin from $MESHFREE_PLUGIN):
   pvpython --no-mpi Data/Scripts/spheric_test2.py --dx 0.04 --end 6 --solver DFSPH --out spheric2_dx0.04.csv

@@ -296,6 +296,7 @@ void SPHFluid::Reorder(SPHState& state)
   };
   permute1(state.DensityStiffness); // DFSPH's warm start (empty for WCSPH)
   permute1(state.DivergenceStiffness);
+  permute1(this->PressureImpulse); // DFSPH: the pressure impulse summed over the Advance() call's steps so far
   // Density and pressure are recomputed by the next force evaluation.
 }
 

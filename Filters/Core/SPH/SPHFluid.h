@@ -171,10 +171,11 @@ struct SPHState
   std::vector<double> Velocity;     ///< 3n
   std::vector<double> Acceleration; ///< 3n, a(x_n) used by the next kick
   std::vector<double> Density;      ///< n
-  std::vector<double> Pressure;     ///< n
+  std::vector<double> Pressure;     ///< n; DFSPH: averaged over the Advance() call (SPHDivergenceFree.cxx)
   std::vector<std::int64_t> Id;     ///< n, stable across time
   /// DFSPH only (empty for WCSPH): the accumulated stiffness kappa (m^2/s^2, P / dt) of each particle's last density
-  /// solve and divergence solve: the warm start of the next step; pressure = rho (the sum of both).
+  /// solve and divergence solve: the warm start of the next step; the step's pressure multiplier is rho (the sum
+  /// of both), and Pressure their average over the steps of the Advance() call (SPHDivergenceFree.cxx).
   std::vector<double> DensityStiffness, DivergenceStiffness;
   SPHSolverReport Report; ///< DFSPH: what the Advance() call that produced this state did
 
@@ -313,9 +314,18 @@ private:
   // pairs' coefficients m GradientNorm shape(r), and each particle's own sum_f G + 2 sum_b G (3 per particle).
   std::vector<double> PairGradient, WallCoefficient, SelfGradient;
   std::vector<double> Alpha, Kappa, KappaOverRho, OldCompression, OldVelocity, Smoothed;
+  // DFSPH: each particle's pressure impulse, sum over the steps of the current Advance() call of dt rho (kappa_density
+  // + kappa_divergence) (permuted with the particles by Reorder), and the time those steps span: the Pressure output
+  // is its time average (SPHDivergenceFree.cxx, "Pressure output").
+  std::vector<double> PressureImpulse;
+  // DFSPH: each particle's gradient strength gamma_i = tr(sum_j V_j (x_i - x_j) (x) m grad W_ij) / (d m) over fluid
+  // and wall neighbours, relative to the lattice's (DivergenceFreeFields): the Pressure output is gamma p.
+  std::vector<double> GradientStrength;
+  double PressureImpulseTime = 0.0;
   std::vector<double> SolveResidual, SolveDirection, SolvePreconditioned, SolveProduct, SolveVelocity; // the CG's
   std::vector<char> SolveFree;
   void SmoothStiffness(const SPHState& state, const std::vector<double>& in, std::vector<double>& out) const;
+  double LatticeGradientStrength = 0.0; // sum_j m GradientNorm shape(r) r^2 of that lattice particle (gamma's scale)
   double LatticeFactorSum = 0.0; // |sum G|^2 + sum |G|^2 of a lattice particle far from walls, for the alpha cutoff
   long UnconvergedStepCount = 0;
 

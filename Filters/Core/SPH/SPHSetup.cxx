@@ -317,7 +317,7 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
     this->Poly6 *= sc > 0.0 ? 1.0 / sc : 1.0; // colour field
     // DFSPH: sum_j |m grad W_ij|^2 of an interior lattice particle (sum_j m grad W_ij vanishes there), the scale
     // below which a particle's factor alpha is set to 0 (too few neighbours to be pushed by pressure).
-    double lattice = 0.0;
+    double lattice = 0.0, strength = 0.0;
     for (int k = -reach; k <= reach; ++k)
     {
       for (int j = (d == 3 ? -reach : 0); j <= (d == 3 ? reach : 0); ++j)
@@ -329,11 +329,15 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
           {
             const double g = this->Mass * this->GradientNorm * this->GradientShape(r2, std::sqrt(r2));
             lattice += g * g * r2;
+            strength += g * r2;
           }
         }
       }
     }
     this->LatticeFactorSum = lattice;
+    // ... and sum_j m GradientNorm shape(r_ij) r_ij^2 of that particle: the normalisation of the gradient strength
+    // gamma_i of the DFSPH Pressure output (SPHDivergenceFree.cxx, "Pressure output"), 1 on the lattice.
+    this->LatticeGradientStrength = strength;
   }
 
   // Boundary (dummy) particles: a shell behind the container walls and a layer inside every obstacle, as
