@@ -643,19 +643,51 @@ int vtkMeshlessSurface::ReconstructDistributed(
     processes.SetSlab(slabs.Axis, slabs.Lower(me), slabs.Upper(me));
     vtkPolyData* local = halo->GetOutput();
     held = local->GetNumberOfPoints();
-    std::vector<double> rows(static_cast<size_t>(held) * layout.Width);
+    // The local cloud's rows, unpacked a block at a time (no second copy of the whole cloud), then the halo's own
+    // copies of the arrays dropped (its exchange plan and points stay, for the halo updates).
     vtkDataArray* travelled = local->GetPointData()->GetArray("MeshFreeRow");
-    for (vtkIdType i = 0; i < held; ++i)
+    constexpr vtkIdType block = 65536;
+    std::vector<double> rows(static_cast<size_t>(std::min(held, block)) * layout.Width);
+    Cloud part;
+    part.Columns = cloud.Columns;
+    cloud.Count = 0;
+    for (vtkIdType begin = 0; begin < held || begin == 0; begin += block)
     {
-      double* row = &rows[static_cast<size_t>(i) * layout.Width];
-      local->GetPoint(i, row);
-      for (int c = 0; c < rest; ++c)
+      const vtkIdType end = std::min(held, begin + block);
+      for (vtkIdType i = begin; i < end; ++i)
       {
-        row[3 + c] = travelled->GetComponent(i, c);
+        double* row = &rows[static_cast<size_t>(i - begin) * layout.Width];
+        local->GetPoint(i, row);
+        for (int c = 0; c < rest; ++c)
+        {
+          row[3 + c] = travelled->GetComponent(i, c);
+        }
+      }
+      UnpackRows(rows.data(), end - begin, layout.Width, layout.UseNormals, layout.UseVolumes, part);
+      if (begin == 0)
+      {
+        cloud.Points.clear();
+        cloud.Normals.clear();
+        cloud.Volumes.clear();
+        cloud.Values.clear();
+        cloud.InvalidVolumes = 0;
+        cloud.Points.reserve(3 * static_cast<size_t>(held));
+        cloud.Normals.reserve(layout.UseNormals ? 3 * static_cast<size_t>(held) : 0);
+        cloud.Volumes.reserve(layout.UseVolumes ? static_cast<size_t>(held) : 0);
+        cloud.Values.reserve(static_cast<size_t>(held) * cloud.Columns);
+      }
+      cloud.Points.insert(cloud.Points.end(), part.Points.begin(), part.Points.end());
+      cloud.Normals.insert(cloud.Normals.end(), part.Normals.begin(), part.Normals.end());
+      cloud.Volumes.insert(cloud.Volumes.end(), part.Volumes.begin(), part.Volumes.end());
+      cloud.Values.insert(cloud.Values.end(), part.Values.begin(), part.Values.end());
+      if (held == 0)
+      {
+        break;
       }
     }
-    UnpackRows(rows.data(), held, layout.Width, layout.UseNormals, layout.UseVolumes, cloud);
+    cloud.Count = held;
     std::vector<double>().swap(rows);
+    local->GetPointData()->Initialize();
     meshfree::SurfaceInput in;
     in.Points = cloud.Points.data();
     in.Count = cloud.Count;
