@@ -115,63 +115,6 @@ std::vector<double> AllGather(
   return all;
 }
 
-GatheredCloud GatherCloud(
-  vtkMultiProcessController* controller, vtkPointSet* local, const std::vector<double>& rows, int width)
-{
-  GatheredCloud cloud;
-  const vtkIdType n = local ? local->GetNumberOfPoints() : 0;
-  cloud.Width = width;
-  if (!controller || controller->GetNumberOfProcesses() <= 1)
-  {
-    cloud.Count = n;
-    cloud.Rows = rows;
-    cloud.Own.resize(static_cast<size_t>(n));
-    std::iota(cloud.Own.begin(), cloud.Own.end(), vtkIdType(0));
-    return cloud;
-  }
-  // The input's global ids, when every rank with points has them (a MAX over "has points but no ids").
-  vtkDataArray* ids = local ? local->GetPointData()->GetGlobalIds() : nullptr;
-  if (ids && (ids->GetNumberOfComponents() != 1 || ids->GetDataType() == VTK_FLOAT ||
-               ids->GetDataType() == VTK_DOUBLE || ids->GetNumberOfTuples() != n))
-  {
-    ids = nullptr;
-  }
-  const int lacking = n > 0 && !ids ? 1 : 0;
-  int anyLacking = lacking;
-  controller->AllReduce(&lacking, &anyLacking, 1, vtkCommunicator::MAX_OP);
-  std::vector<double> local1(static_cast<size_t>(n) * (width + 1));
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    double* row = &local1[static_cast<size_t>(i) * (width + 1)];
-    row[0] = anyLacking ? 0.0 : static_cast<double>(static_cast<vtkIdType>(ids->GetTuple1(i)));
-    std::copy_n(&rows[static_cast<size_t>(i) * width], width, row + 1);
-  }
-  vtkIdType offset = 0;
-  const std::vector<double> all = AllGather(controller, local1, &offset);
-  offset /= width + 1; // values to points
-  cloud.Count = static_cast<vtkIdType>(all.size() / (width + 1));
-  std::vector<vtkIdType> order(static_cast<size_t>(cloud.Count));
-  std::iota(order.begin(), order.end(), vtkIdType(0));
-  if (!anyLacking) // otherwise the concatenation is the order
-  {
-    std::stable_sort(order.begin(), order.end(), [&all, width](vtkIdType a, vtkIdType b) {
-      return all[static_cast<size_t>(a) * (width + 1)] < all[static_cast<size_t>(b) * (width + 1)];
-    });
-  }
-  cloud.Rows.resize(static_cast<size_t>(cloud.Count) * width);
-  cloud.Own.resize(static_cast<size_t>(n));
-  for (vtkIdType s = 0; s < cloud.Count; ++s)
-  {
-    std::copy_n(
-      &all[static_cast<size_t>(order[s]) * (width + 1) + 1], width, &cloud.Rows[static_cast<size_t>(s) * width]);
-    if (order[s] >= offset && order[s] < offset + n)
-    {
-      cloud.Own[order[s] - offset] = s;
-    }
-  }
-  return cloud;
-}
-
 void CanonicalTriangles(std::vector<double>& soup)
 {
   std::vector<Triangle> triangles(soup.size() / 9);

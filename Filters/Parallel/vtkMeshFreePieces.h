@@ -52,25 +52,6 @@ std::vector<double> AllGather(const std::vector<double>& local, bool distributed
 std::vector<double> AllGather(
   vtkMultiProcessController* controller, const std::vector<double>& local, vtkIdType* offset = nullptr);
 
-/// A point cloud gathered whole on every rank in a canonical order (GatherCloud).
-struct GatheredCloud
-{
-  vtkIdType Count = 0;        // points in the whole cloud
-  int Width = 0;              // values per point
-  std::vector<double> Rows;   // Count x Width values, ordered by global id
-  std::vector<vtkIdType> Own; // for each of this rank's points, in input order: its row in Rows
-};
-
-/// Collective over `controller` (every rank must call it, ranks with empty pieces included). `rows` holds `width`
-/// values for each of the points of `local` (width the same on every rank); the result holds every rank's rows on
-/// every rank, ordered by global id: the input's GlobalIds (one integer component) when every rank with points has
-/// them, otherwise the index in the cloud concatenated rank by rank, which is the serial index when the cloud is split
-/// by index (a reader's pieces). A serial algorithm run on these rows therefore sees the serial cloud whatever the
-/// number of ranks. Without a controller, or with one process, the rows stay as they are. Memory: the whole cloud's
-/// rows on every rank.
-GatheredCloud GatherCloud(
-  vtkMultiProcessController* controller, vtkPointSet* local, const std::vector<double>& rows, int width);
-
 /// Puts a triangle soup (9 coordinates per triangle) in a canonical form that depends only on the set of
 /// triangles: each triangle rotated to start at its lexicographically smallest vertex (orientation kept), the
 /// triangles sorted, exact duplicates removed (ghost cells, or an input that every rank holds whole). Serial and
