@@ -279,12 +279,13 @@ std::vector<double> Noisy(bool torus, Index n, double sigma, unsigned seed)
 }
 } // namespace
 
-TEST(DistributedSurface, OpenTorusOnThreeSlabsIsTheSerialSurface)
+TEST(DistributedSurface, OpenTorusOnThreeAndFourSlabsIsTheSerialSurface)
 {
   std::vector<double> xyz = Noisy(true, 12000, 0.004, 7);
   SurfaceOptions options;
   options.HoleFilling = HoleFillingMode::Off;
   ExpectSameAsSerial(Reconstruct(xyz, options, 3, 0.6));
+  ExpectSameAsSerial(Reconstruct(xyz, options, 4, 0.6));
 }
 
 TEST(DistributedSurface, WLSSphereOnTwoSlabsIsTheSerialSurface)
@@ -341,9 +342,12 @@ TEST(DistributedSurface, ClosedSphereWithHolesFilledIsTheSerialSurface)
 {
   std::vector<double> xyz = Noisy(false, 30000, 0.002, 5);
   SurfaceOptions options; // Auto: the sphere encloses a volume
-  const Runs run = Reconstruct(xyz, options, 3, 0.45);
-  EXPECT_TRUE(run.SerialReport.HolesFilled);
-  ExpectSameAsSerial(run);
+  for (const int size : { 3, 4 })
+  {
+    const Runs run = Reconstruct(xyz, options, size, 0.45);
+    EXPECT_TRUE(run.SerialReport.HolesFilled);
+    ExpectSameAsSerial(run);
+  }
 }
 
 TEST(DistributedSurface, ScanWithAnUnseenUndersideFilledIsTheSerialSurface)
