@@ -695,15 +695,21 @@ int vtkMeshlessSurface::ReconstructDistributed(
     in.Volumes = cloud.Volumes.empty() ? nullptr : cloud.Volumes.data();
     options.Processes = &processes;
     std::string error;
-    const bool done = meshfree::ReconstructSurface(in, options, result.Mesh, result.Report, error,
-      attempt == 0 ? vtkMeshFreeFilterSupport::Progress(this, 0.0, 0.9) : meshfree::ProgressCallback());
+    // Progress is reported, but an abort is honoured only after the core: every rank must go through its
+    // collective steps (an abort request reaches the ranks at different moments, if at all).
+    const meshfree::ProgressCallback progress = [this](double f) {
+      this->UpdateProgress(0.9 * f);
+      return true;
+    };
+    const bool done = meshfree::ReconstructSurface(
+      in, options, result.Mesh, result.Report, error, attempt == 0 ? progress : meshfree::ProgressCallback());
     options.Processes = nullptr;
     if (!done && !result.Report.Aborted)
     {
       vtkErrorMacro("Invalid settings: " << error << " The output is empty.");
       return 1;
     }
-    if (vtkMeshFreeHalo::GlobalMax(controller, done && !result.Report.Aborted ? 0.0 : 1.0) > 0.0)
+    if (vtkMeshFreeHalo::GlobalMax(controller, done && !result.Report.Aborted && !this->GetAbortExecute() ? 0.0 : 1.0) > 0.0)
     {
       vtkWarningMacro("Aborted: the output is empty.");
       return 1;

@@ -407,3 +407,19 @@ TEST(DistributedSurface, FluidShellWithDuplicateParticlesIsTheSerialSurface)
   options.Method = SurfaceMethod::SPH;
   ExpectSameAsSerial(Reconstruct(xyz, options, 2, 0.3));
 }
+
+TEST(DistributedSurface, SlabsWithoutSurfaceTakePartAndAgree)
+{
+  // Half the points on a line far from the sphere: the slabs that hold them have no triangles, yet take part in
+  // every collective step (stray pieces, boundary edges) and the whole surface is the serial one.
+  std::vector<double> xyz = Noisy(false, 6000, 0.003, 21);
+  for (int i = 0; i < 6000; ++i)
+  {
+    xyz.insert(xyz.end(), { 5.0 + i / 6000.0, 0.0, 0.0 });
+  }
+  SurfaceOptions options;
+  options.HoleFilling = HoleFillingMode::Off;
+  const Runs run = Reconstruct(xyz, options, 4, 0.5);
+  EXPECT_EQ(run.Meshes[3].NumberOfTriangles(), 0);
+  ExpectSameAsSerial(run);
+}

@@ -606,7 +606,8 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       report.TrimmedTriangles = KeepTriangles(
         mesh, TrimmedTriangles(mesh, mesh.Normals, grid, mesh.DistanceToData, vertexNear, vertexLimit), attributes);
     }
-    if (options.RemoveStrayPieces && mesh.NumberOfTriangles() > 0)
+    // (Distributed: every process alike, a part without triangles too - the pieces are the whole mesh's.)
+    if (options.RemoveStrayPieces && GlobalSum(d, mesh.NumberOfTriangles()) > 0)
     {
       const Index before = mesh.NumberOfTriangles();
       const std::vector<unsigned char> keep = SupportedPieces(mesh, grid, limit,

@@ -86,7 +86,8 @@ struct SurfaceOptions
   // Distributed (Common/Distribution.h): the input is this process' points and their halo; the grid is framed by
   // the whole cloud (FrameBounds: the bounds of its valid points, FramePoints: their number; NeighborGrid::SetFrame);
   // each process contours the lattice cells whose centre it owns (Distribution::OwnsPosition) and the mesh is
-  // their triangles; normals, fits and statistics are the whole cloud's. Null: serial.
+  // their triangles; normals, fits and statistics are the whole cloud's. Every step is collective: a progress
+  // callback given with it must not abort (an abort would leave the other processes waiting). Null: serial.
   const Distribution* Processes = nullptr;
   bool Framed = false;
   double FrameBounds[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 };
