@@ -9,6 +9,7 @@
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkIdList.h"
+#include "vtkIdTypeArray.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMeshFreeHalo.h"
@@ -62,6 +63,9 @@ struct vtkMeshlessSurface::Cloud
   int Columns = 0;
   std::vector<double> Values;
   std::string ActiveScalars;
+  /// Distributed: the coordinates as the halo holds them (Points then stays empty); null: Points.
+  const double* View = nullptr;
+  const double* Coordinates() const { return this->View ? this->View : this->Points.data(); }
 };
 
 /// What one row of the cloud holds: coordinates, then normals, volume and the arrays' values as agreed.
@@ -466,7 +470,7 @@ void vtkMeshlessSurface::AddApproximatedArrays(
     vtkWarningMacro("The point arrays are not approximated: " << approximator.Error());
     return;
   }
-  approximator.SetCloud(cloud.Points.data(), n, values.data(), columns);
+  approximator.SetCloud(cloud.Coordinates(), n, values.data(), columns);
   const vtkIdType excludedForValues = approximator.Report().ExcludedPoints - result.Report.InvalidPoints;
   if (excludedForValues > 0 && reporter)
   {
@@ -627,6 +631,7 @@ int vtkMeshlessSurface::ReconstructDistributed(
   }
   vtkNew<vtkMeshFreeHalo> halo;
   halo->SetController(controller);
+  vtkSmartPointer<vtkIdTypeArray> ownIds;
   Result result;
   int attempts = 0;
   vtkIdType held = 0;
@@ -637,8 +642,44 @@ int vtkMeshlessSurface::ReconstructDistributed(
     {
       radius = std::numeric_limits<double>::infinity();
     }
+    if (!mine)
+    {
+      // A retry: this rank's slab points again, from the last halo's owned points (the first `own`, in order), their
+      // rows (the local cloud's) and their global ids (kept aside).
+      vtkPolyData* last = halo->GetOutput();
+      mine = vtkSmartPointer<vtkPolyData>::New();
+      vtkNew<vtkPoints> again;
+      again->SetDataTypeToDouble();
+      again->SetNumberOfPoints(own);
+      vtkNew<vtkDoubleArray> rowsAgain;
+      rowsAgain->SetName("MeshFreeRow");
+      rowsAgain->SetNumberOfComponents(std::max(rest, 1));
+      rowsAgain->SetNumberOfTuples(own);
+      for (vtkIdType i = 0; i < own; ++i)
+      {
+        again->SetPoint(i, last->GetPoint(i));
+        int c = 0;
+        for (int a = 0; layout.UseNormals && a < 3; ++a)
+        {
+          rowsAgain->SetComponent(i, c++, cloud.Normals[3 * i + a]);
+        }
+        if (layout.UseVolumes)
+        {
+          rowsAgain->SetComponent(i, c++, cloud.Volumes[i]);
+        }
+        for (int v = 0; v < cloud.Columns; ++v)
+        {
+          rowsAgain->SetComponent(i, c++, cloud.Values[static_cast<size_t>(i) * cloud.Columns + v]);
+        }
+      }
+      mine->SetPoints(again);
+      mine->GetPointData()->AddArray(rowsAgain);
+      mine->GetPointData()->SetGlobalIds(ownIds);
+    }
     halo->Exchange(mine, region, radius);
     attempts = attempt + 1;
+    // The slab's points live on in the halo's output (its first `own`): released here, rebuilt for a retry.
+    mine = nullptr;
     vtkMeshFreeHaloDistribution processes(controller, halo, region, radius);
     processes.SetSlab(slabs.Axis, slabs.Lower(me), slabs.Upper(me));
     vtkPolyData* local = halo->GetOutput();
@@ -671,12 +712,10 @@ int vtkMeshlessSurface::ReconstructDistributed(
         cloud.Volumes.clear();
         cloud.Values.clear();
         cloud.InvalidVolumes = 0;
-        cloud.Points.reserve(3 * static_cast<size_t>(held));
         cloud.Normals.reserve(layout.UseNormals ? 3 * static_cast<size_t>(held) : 0);
         cloud.Volumes.reserve(layout.UseVolumes ? static_cast<size_t>(held) : 0);
         cloud.Values.reserve(static_cast<size_t>(held) * cloud.Columns);
       }
-      cloud.Points.insert(cloud.Points.end(), part.Points.begin(), part.Points.end());
       cloud.Normals.insert(cloud.Normals.end(), part.Normals.begin(), part.Normals.end());
       cloud.Volumes.insert(cloud.Volumes.end(), part.Volumes.begin(), part.Volumes.end());
       cloud.Values.insert(cloud.Values.end(), part.Values.begin(), part.Values.end());
@@ -687,9 +726,29 @@ int vtkMeshlessSurface::ReconstructDistributed(
     }
     cloud.Count = held;
     std::vector<double>().swap(rows);
+    // The coordinates are read where the halo holds them (double, as the exchange keeps them).
+    vtkDoubleArray* coordinates =
+      held > 0 ? vtkDoubleArray::SafeDownCast(local->GetPoints()->GetData()) : nullptr;
+    if (held > 0 && !coordinates)
+    {
+      cloud.Points.resize(3 * static_cast<size_t>(held));
+      for (vtkIdType i = 0; i < held; ++i)
+      {
+        local->GetPoint(i, &cloud.Points[3 * i]);
+      }
+    }
+    cloud.View = coordinates ? coordinates->GetPointer(0) : nullptr;
+    // The own points' global ids are kept for a retry; the halo's copies of the arrays go.
+    ownIds = vtkSmartPointer<vtkIdTypeArray>::New();
+    if (vtkIdTypeArray* ids = halo->GetGlobalIds())
+    {
+      ownIds->SetName(ids->GetName());
+      ownIds->SetNumberOfTuples(own);
+      std::copy_n(ids->GetPointer(0), own, ownIds->GetPointer(0));
+    }
     local->GetPointData()->Initialize();
     meshfree::SurfaceInput in;
-    in.Points = cloud.Points.data();
+    in.Points = cloud.Coordinates();
     in.Count = cloud.Count;
     in.Normals = cloud.Normals.empty() ? nullptr : cloud.Normals.data();
     in.Volumes = cloud.Volumes.empty() ? nullptr : cloud.Volumes.data();
