@@ -296,32 +296,60 @@ void vtkMeshlessSurface::PrepareInput(
 
 namespace
 {
-/// The cloud's arrays from `count` rows of the layout.
+/// Sizes the cloud's per-point arrays (all but the coordinates) for `count` points of the layout.
 template <class Cloud>
-void UnpackRows(const double* rows, vtkIdType count, int width, bool useNormals, bool useVolumes, Cloud& cloud)
+void SizeCloud(Cloud& cloud, vtkIdType count, bool useNormals, bool useVolumes)
 {
   cloud.Count = count;
-  cloud.Points.resize(3 * static_cast<size_t>(count));
   cloud.Normals.resize(useNormals ? 3 * static_cast<size_t>(count) : 0);
   cloud.Volumes.resize(useVolumes ? static_cast<size_t>(count) : 0);
   cloud.Values.resize(static_cast<size_t>(count) * cloud.Columns);
   cloud.InvalidVolumes = 0;
+}
+
+/// Point i's row after its coordinates (normals, volume, the arrays' values, as the layout has them) into the
+/// cloud, or (GetRowTail) back out of it.
+template <class Cloud>
+void SetRowTail(Cloud& cloud, vtkIdType i, const double* tail)
+{
+  if (!cloud.Normals.empty())
+  {
+    std::copy_n(tail, 3, &cloud.Normals[3 * i]);
+    tail += 3;
+  }
+  if (!cloud.Volumes.empty())
+  {
+    cloud.Volumes[i] = *tail++;
+    cloud.InvalidVolumes += (cloud.Volumes[i] > 0.0 && std::isfinite(cloud.Volumes[i])) ? 0 : 1;
+  }
+  std::copy_n(tail, cloud.Columns, &cloud.Values[static_cast<size_t>(i) * cloud.Columns]);
+}
+
+template <class Cloud>
+void GetRowTail(const Cloud& cloud, vtkIdType i, double* tail)
+{
+  if (!cloud.Normals.empty())
+  {
+    tail = std::copy_n(&cloud.Normals[3 * i], 3, tail);
+  }
+  if (!cloud.Volumes.empty())
+  {
+    *tail++ = cloud.Volumes[i];
+  }
+  std::copy_n(&cloud.Values[static_cast<size_t>(i) * cloud.Columns], cloud.Columns, tail);
+}
+
+/// The cloud's arrays from `count` rows of the layout.
+template <class Cloud>
+void UnpackRows(const double* rows, vtkIdType count, int width, bool useNormals, bool useVolumes, Cloud& cloud)
+{
+  SizeCloud(cloud, count, useNormals, useVolumes);
+  cloud.Points.resize(3 * static_cast<size_t>(count));
   for (vtkIdType i = 0; i < count; ++i)
   {
     const double* row = rows + static_cast<size_t>(i) * width;
     std::copy_n(row, 3, &cloud.Points[3 * i]);
-    row += 3;
-    if (useNormals)
-    {
-      std::copy_n(row, 3, &cloud.Normals[3 * i]);
-      row += 3;
-    }
-    if (useVolumes)
-    {
-      cloud.Volumes[i] = *row++;
-      cloud.InvalidVolumes += (cloud.Volumes[i] > 0.0 && std::isfinite(cloud.Volumes[i])) ? 0 : 1;
-    }
-    std::copy_n(row, cloud.Columns, &cloud.Values[static_cast<size_t>(i) * cloud.Columns]);
+    SetRowTail(cloud, i, row + 3);
   }
 }
 } // namespace
@@ -655,22 +683,12 @@ int vtkMeshlessSurface::ReconstructDistributed(
       rowsAgain->SetName("MeshFreeRow");
       rowsAgain->SetNumberOfComponents(std::max(rest, 1));
       rowsAgain->SetNumberOfTuples(own);
+      std::vector<double> tail(static_cast<size_t>(std::max(rest, 1)), 0.0);
       for (vtkIdType i = 0; i < own; ++i)
       {
         again->SetPoint(i, last->GetPoint(i));
-        int c = 0;
-        for (int a = 0; layout.UseNormals && a < 3; ++a)
-        {
-          rowsAgain->SetComponent(i, c++, cloud.Normals[3 * i + a]);
-        }
-        if (layout.UseVolumes)
-        {
-          rowsAgain->SetComponent(i, c++, cloud.Volumes[i]);
-        }
-        for (int v = 0; v < cloud.Columns; ++v)
-        {
-          rowsAgain->SetComponent(i, c++, cloud.Values[static_cast<size_t>(i) * cloud.Columns + v]);
-        }
+        GetRowTail(cloud, i, tail.data());
+        rowsAgain->SetTuple(i, tail.data());
       }
       mine->SetPoints(again);
       mine->GetPointData()->AddArray(rowsAgain);
@@ -684,48 +702,17 @@ int vtkMeshlessSurface::ReconstructDistributed(
     processes.SetSlab(slabs.Axis, slabs.Lower(me), slabs.Upper(me));
     vtkPolyData* local = halo->GetOutput();
     held = local->GetNumberOfPoints();
-    // The local cloud's rows, unpacked a block at a time (no second copy of the whole cloud), then the halo's own
-    // copies of the arrays dropped (its exchange plan and points stay, for the halo updates).
+    // The local cloud's arrays from the rows that travelled (the coordinates stay where the halo holds them, below),
+    // then the halo's own copies of the arrays dropped (its exchange plan and points stay, for the halo updates).
     vtkDataArray* travelled = local->GetPointData()->GetArray("MeshFreeRow");
-    constexpr vtkIdType block = 65536;
-    std::vector<double> rows(static_cast<size_t>(std::min(held, block)) * layout.Width);
-    Cloud part;
-    part.Columns = cloud.Columns;
-    cloud.Count = 0;
-    for (vtkIdType begin = 0; begin < held || begin == 0; begin += block)
+    cloud.Points.clear();
+    SizeCloud(cloud, held, layout.UseNormals, layout.UseVolumes);
+    std::vector<double> tail(static_cast<size_t>(std::max(rest, 1)), 0.0);
+    for (vtkIdType i = 0; i < held; ++i)
     {
-      const vtkIdType end = std::min(held, begin + block);
-      for (vtkIdType i = begin; i < end; ++i)
-      {
-        double* row = &rows[static_cast<size_t>(i - begin) * layout.Width];
-        local->GetPoint(i, row);
-        for (int c = 0; c < rest; ++c)
-        {
-          row[3 + c] = travelled->GetComponent(i, c);
-        }
-      }
-      UnpackRows(rows.data(), end - begin, layout.Width, layout.UseNormals, layout.UseVolumes, part);
-      if (begin == 0)
-      {
-        cloud.Points.clear();
-        cloud.Normals.clear();
-        cloud.Volumes.clear();
-        cloud.Values.clear();
-        cloud.InvalidVolumes = 0;
-        cloud.Normals.reserve(layout.UseNormals ? 3 * static_cast<size_t>(held) : 0);
-        cloud.Volumes.reserve(layout.UseVolumes ? static_cast<size_t>(held) : 0);
-        cloud.Values.reserve(static_cast<size_t>(held) * cloud.Columns);
-      }
-      cloud.Normals.insert(cloud.Normals.end(), part.Normals.begin(), part.Normals.end());
-      cloud.Volumes.insert(cloud.Volumes.end(), part.Volumes.begin(), part.Volumes.end());
-      cloud.Values.insert(cloud.Values.end(), part.Values.begin(), part.Values.end());
-      if (held == 0)
-      {
-        break;
-      }
+      travelled->GetTuple(i, tail.data());
+      SetRowTail(cloud, i, tail.data());
     }
-    cloud.Count = held;
-    std::vector<double>().swap(rows);
     // The coordinates are read where the halo holds them (double, as the exchange keeps them).
     vtkDoubleArray* coordinates =
       held > 0 ? vtkDoubleArray::SafeDownCast(local->GetPoints()->GetData()) : nullptr;
