@@ -664,6 +664,7 @@ int vtkMeshlessSurface::ReconstructDistributed(
   int attempts = 0;
   vtkIdType held = 0;
   vtkIdType boundaryEdges = 0;
+  double shortfall = 0.0;
   for (int attempt = 0; attempt < 4; ++attempt)
   {
     if (attempt == 3 || !std::isfinite(radius) || !(radius > 0.0))
@@ -760,7 +761,7 @@ int vtkMeshlessSurface::ReconstructDistributed(
       vtkWarningMacro("Aborted: the output is empty.");
       return 1;
     }
-    const double shortfall = vtkMeshFreeHalo::GlobalMax(controller, result.Report.Shortfall);
+    shortfall = vtkMeshFreeHalo::GlobalMax(controller, result.Report.Shortfall);
     vtkDebugMacro("Halo radius " << radius << ": " << held << " points held, shortfall " << shortfall << ".");
     if (!(shortfall > 0.0) || std::isinf(radius))
     {
@@ -806,6 +807,8 @@ int vtkMeshlessSurface::ReconstructDistributed(
   fd->AddArray(local);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", radius);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloAttempts", attempts);
+  // The halo width the last attempt needed: its radius less the slack every computation left (or plus its shortfall).
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloNeeded", std::isfinite(shortfall) ? radius + shortfall : 0.0);
   return 1;
 }
 

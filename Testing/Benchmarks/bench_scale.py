@@ -93,6 +93,23 @@ out.GetPointData().SetGlobalIds(ids)
 STAGES = ("SetupSeconds", "ContourSeconds", "ProjectionSeconds", "ApproximationSeconds")
 
 
+def reset_peak():
+    """Resets the process's resident high-water mark (Linux: clear_refs 5) so that the peak read after the filter is
+    the filter's, not the cloud generator's; False where the kernel does not allow it."""
+    try:
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")
+        return True
+    except OSError:
+        return False
+
+
+def peak_since_reset_mb():
+    """The resident high-water mark since reset_peak() (MiB)."""
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) for line in f if line.startswith("VmHWM:")) / 1024.0
+
+
 def field_value(data, name):
     array = data.GetFieldData().GetArray(name)
     return float(array.GetValue(0)) if array is not None and array.GetNumberOfTuples() > 0 else None
@@ -112,6 +129,7 @@ def worker(args):
     else:
         algorithm = plugin["MeshlessSurface"](Input=cloud, Method=0)
     start_mb = resident_mb()
+    reset = reset_peak()  # the filter's own peak, not the cloud generator's
     if controller:
         controller.Barrier()
     start = time.perf_counter()
@@ -120,7 +138,7 @@ def worker(args):
         controller.Barrier()
     elapsed = time.perf_counter() - start
     out = algorithm.GetClientSideObject().GetOutputDataObject(0)
-    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    peak_mb = peak_since_reset_mb() if reset else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     held = field_value(out, "LocalCloudPoints")  # a distributed filter: its piece and halo
     held = field_value(out, "GatheredPoints") if held is None else held
     if held is None:
@@ -128,7 +146,8 @@ def worker(args):
         held = owned + halo if halo is not None else float(args.points)  # today's filters gather the cloud
     row = dict(rank=rank, ranks=ranks, seconds=elapsed, owned=owned, held=held, rss_mb=peak_mb,
                growth_mb=peak_mb - start_mb, output=out.GetNumberOfPoints(),
-               stages={name: field_value(out, name) for name in STAGES})
+               stages={name: field_value(out, name) for name in STAGES},
+               halo={name: field_value(out, name) for name in ("HaloRadius", "HaloNeeded", "HaloAttempts")})
     with open(os.path.join(args.out, f"rank{rank}.json"), "w") as f:
         json.dump(row, f)
 

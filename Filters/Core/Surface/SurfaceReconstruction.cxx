@@ -558,11 +558,30 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   report.ContourSeconds = seconds(start);
   if (d)
   {
-    // The fits read the samples within the largest support (at most 3 x the median) of a corner, up to a cell
-    // from a vertex, and the projection moves a vertex by at most a cell; the fluid's kernels (H, stretched up to
-    // 4^(2/3) and shifted) read their particles' neighbours within two spacings (H).
-    const double reach = (options.Method == SurfaceMethod::SPH && options.Anisotropic ? 4.5 : 3.0) *
-        report.SupportRadius + 2.0 * lattice.CellSize;
+    // A vertex's field reads up to a cell away (the contour's corners), and the projection moves it by at most a
+    // cell. MLS: the samples within the largest support of the whole cloud (at most 3 x the median); WLS: the
+    // patches within the median support rho, whose centres and fits read the points within rho of them; the
+    // fluid's kernels (H, stretched up to 4^(2/3) and shifted) read their particles' neighbours within two
+    // spacings (H).
+    double read = 3.0 * report.SupportRadius;
+    if (options.Method == SurfaceMethod::MLS)
+    {
+      double largest = 0.0;
+      for (size_t i = 0; i < support.size(); ++i)
+      {
+        largest = IsOwn(d, static_cast<Index>(i)) ? std::max(largest, support[i]) : largest;
+      }
+      read = GlobalMax(d, largest);
+    }
+    else if (options.Method == SurfaceMethod::WLS)
+    {
+      read = 2.0 * report.SupportRadius;
+    }
+    else if (options.Anisotropic)
+    {
+      read = 4.5 * report.SupportRadius;
+    }
+    const double reach = read + 2.0 * lattice.CellSize;
     for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
     {
       report.Shortfall = std::max(report.Shortfall, Shortfall(d, &mesh.Points[3 * v], reach));
