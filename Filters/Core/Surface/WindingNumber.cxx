@@ -162,7 +162,7 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     Node& node = this->Nodes[k];
     if (node.Left >= 0)
     {
-      this->Combine(node);
+      this->Combine(node, this->Nodes[node.Left], this->Nodes[node.Right]);
       continue;
     }
     std::fill(node.Moment, node.Moment + 3, 0.0);
@@ -256,8 +256,8 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     this->Nodes.clear();
     return;
   }
-  // The top tree's leaves: the held cubes' roots, remote leaves for the others.
-  std::vector<Index> roots(nc);
+  // The top tree's leaves in key order: the held cubes' roots, the others' gathered records.
+  std::vector<TopLeaf> leaves(nc);
   size_t next = 0;
   for (size_t c = 0; c < nc; ++c)
   {
@@ -266,41 +266,97 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     {
       ++next;
     }
-    if (next < held.size() && held[next].first == key)
-    {
-      roots[c] = heldRoot[next];
-      continue;
-    }
-    const double* r = &all[kRecord * gathered[c].second + 2];
-    Node node;
-    std::copy(r, r + 3, node.Centre);
-    std::copy(r + 3, r + 6, node.Moment);
-    std::copy(r + 6, r + 15, node.Second);
-    std::copy(r + 15, r + 42, node.Third);
-    node.Radius = r[42];
-    node.Area = r[43];
-    node.Begin = node.End = 0;
-    node.Left = node.Right = -2;
-    roots[c] = static_cast<Index>(this->Nodes.size());
-    this->Nodes.push_back(node);
+    const bool mine = next < held.size() && held[next].first == key;
+    leaves[c].Held = mine ? heldRoot[next] : Index(-1);
+    leaves[c].Record = mine ? nullptr : &all[kRecord * gathered[c].second + 2];
   }
-  this->Root = this->BuildTop(roots, 0, nc);
+  std::vector<std::pair<std::uint64_t, size_t>>().swap(gathered);
+  // The top tree's shapes first (centre, radius, area: its splits and which nodes this process needs), then its
+  // nodes: distributed, a node no evaluation of this process can open keeps only its moments (TopNeeded).
+  std::vector<TopShape> shapes(nc - 1);
+  this->ShapeTop(leaves, 0, nc, 0, shapes);
+  this->Root = this->EmitTop(leaves, 0, nc, 0, shapes, d && lattice ? d : nullptr);
   this->Total = this->Nodes[this->Root].Area;
 }
 
-Index WindingNumber::BuildTop(std::vector<Index>& roots, size_t begin, size_t end)
+namespace
+{
+/// A node's centre (area-weighted), area and radius bound from its two children's, as WindingNumber::Combine.
+template <typename Child, typename Parent>
+void CombineShape(const Child& left, const Child& right, Parent& node)
+{
+  const double area = left.Area + right.Area;
+  for (int a = 0; a < 3; ++a)
+  {
+    node.Centre[a] = (left.Area * left.Centre[a] + right.Area * right.Centre[a]) / area;
+  }
+  node.Area = area;
+  node.Radius = 0.0;
+  for (const Child* child : { &left, &right })
+  {
+    const double e[3] = { child->Centre[0] - node.Centre[0], child->Centre[1] - node.Centre[1],
+      child->Centre[2] - node.Centre[2] };
+    node.Radius = std::max(node.Radius, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + child->Radius);
+  }
+}
+} // namespace
+
+WindingNumber::TopShape WindingNumber::LeafShape(const TopLeaf& leaf) const
+{
+  TopShape shape;
+  if (leaf.Held >= 0)
+  {
+    const Node& node = this->Nodes[leaf.Held];
+    std::copy(node.Centre, node.Centre + 3, shape.Centre);
+    shape.Radius = node.Radius;
+    shape.Area = node.Area;
+  }
+  else
+  {
+    std::copy(leaf.Record, leaf.Record + 3, shape.Centre);
+    shape.Radius = leaf.Record[42];
+    shape.Area = leaf.Record[43];
+  }
+  return shape;
+}
+
+WindingNumber::Node WindingNumber::LeafNode(const TopLeaf& leaf) const
+{
+  if (leaf.Held >= 0)
+  {
+    return this->Nodes[leaf.Held];
+  }
+  const double* r = leaf.Record;
+  Node node;
+  std::copy(r, r + 3, node.Centre);
+  std::copy(r + 3, r + 6, node.Moment);
+  std::copy(r + 6, r + 15, node.Second);
+  std::copy(r + 15, r + 42, node.Third);
+  node.Radius = r[42];
+  node.Area = r[43];
+  node.Begin = node.End = 0;
+  node.Left = node.Right = -2;
+  return node;
+}
+
+WindingNumber::TopShape WindingNumber::ShapeTop(
+  std::vector<TopLeaf>& leaves, size_t begin, size_t end, size_t index, std::vector<TopShape>& shapes) const
 {
   if (end - begin == 1)
   {
-    return roots[begin];
+    return this->LeafShape(leaves[begin]);
   }
+  // Median split of the leaves' centres along the widest axis; the leaves are in key order, and a stable sort by
+  // the centre keeps ties in key order. A node's internal descendants follow it (pre-order): its left child at
+  // index + 1, its right child after the left's mid - begin - 1 internal nodes.
   double lo[3] = { HUGE_VAL, HUGE_VAL, HUGE_VAL }, hi[3] = { -HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
   for (size_t k = begin; k < end; ++k)
   {
+    const TopShape shape = this->LeafShape(leaves[k]);
     for (int a = 0; a < 3; ++a)
     {
-      lo[a] = std::min(lo[a], this->Nodes[roots[k]].Centre[a]);
-      hi[a] = std::max(hi[a], this->Nodes[roots[k]].Centre[a]);
+      lo[a] = std::min(lo[a], shape.Centre[a]);
+      hi[a] = std::max(hi[a], shape.Centre[a]);
     }
   }
   int axis = 0;
@@ -308,28 +364,71 @@ Index WindingNumber::BuildTop(std::vector<Index>& roots, size_t begin, size_t en
   {
     axis = hi[a] - lo[a] > hi[axis] - lo[axis] ? a : axis;
   }
-  // roots[begin, end) are in key order; a stable sort by the centre keeps ties in key order.
-  std::stable_sort(roots.begin() + static_cast<std::ptrdiff_t>(begin), roots.begin() + static_cast<std::ptrdiff_t>(end),
-    [this, axis](Index a, Index b) { return this->Nodes[a].Centre[axis] < this->Nodes[b].Centre[axis]; });
+  std::stable_sort(leaves.begin() + static_cast<std::ptrdiff_t>(begin), leaves.begin() + static_cast<std::ptrdiff_t>(end),
+    [this, axis](const TopLeaf& a, const TopLeaf& b) {
+      return this->LeafShape(a).Centre[axis] < this->LeafShape(b).Centre[axis];
+    });
   const size_t mid = begin + (end - begin) / 2;
-  const Index left = this->BuildTop(roots, begin, mid);
-  const Index right = this->BuildTop(roots, mid, end);
+  const TopShape left = this->ShapeTop(leaves, begin, mid, index + 1, shapes);
+  const TopShape right = this->ShapeTop(leaves, mid, end, index + (mid - begin), shapes);
+  CombineShape(left, right, shapes[index]);
+  return shapes[index];
+}
+
+WindingNumber::Node WindingNumber::TopMoments(const std::vector<TopLeaf>& leaves, size_t begin, size_t end) const
+{
+  if (end - begin == 1)
+  {
+    return this->LeafNode(leaves[begin]);
+  }
+  const size_t mid = begin + (end - begin) / 2;
+  const Node left = this->TopMoments(leaves, begin, mid);
+  const Node right = this->TopMoments(leaves, mid, end);
   Node node;
   node.Begin = node.End = 0;
-  node.Left = left;
-  node.Right = right;
-  this->Combine(node);
+  this->Combine(node, left, right);
+  return node;
+}
+
+Index WindingNumber::EmitTop(const std::vector<TopLeaf>& leaves, size_t begin, size_t end, size_t index,
+  const std::vector<TopShape>& shapes, const Distribution* d)
+{
+  if (end - begin == 1 && leaves[begin].Held >= 0)
+  {
+    return leaves[begin].Held;
+  }
+  Node node;
+  if (end - begin == 1)
+  {
+    node = this->LeafNode(leaves[begin]);
+  }
+  else if (d && -d->Complete(shapes[index].Centre) > 1.001 * std::sqrt(this->Beta2) * shapes[index].Radius)
+  {
+    // Every evaluation is made where the local cloud is complete (Distribution::Complete(x) >= 0); a node whose
+    // centre lies farther than Beta radii from there is never opened: its moments stand for its subtree, whose nodes
+    // this process does not keep (a leaf of another process, -2; the sums and their bits are the same).
+    node = this->TopMoments(leaves, begin, end);
+    node.Left = node.Right = -2;
+  }
+  else
+  {
+    const size_t mid = begin + (end - begin) / 2;
+    node.Begin = node.End = 0;
+    node.Left = this->EmitTop(leaves, begin, mid, index + 1, shapes, d);
+    node.Right = this->EmitTop(leaves, mid, end, index + (mid - begin), shapes, d);
+    this->Combine(node, this->Nodes[node.Left], this->Nodes[node.Right]);
+  }
   this->Nodes.push_back(node);
   return static_cast<Index>(this->Nodes.size() - 1);
 }
 
-void WindingNumber::Combine(Node& node) const
+void WindingNumber::Combine(Node& node, const Node& left, const Node& right) const
 {
   std::fill(node.Moment, node.Moment + 3, 0.0);
   std::fill(node.Second, node.Second + 9, 0.0);
   std::fill(node.Third, node.Third + 27, 0.0);
   double area = 0.0, c[3] = { 0, 0, 0 };
-  const Node* children[2] = { &this->Nodes[node.Left], &this->Nodes[node.Right] };
+  const Node* children[2] = { &left, &right };
   for (const Node* child : children)
   {
     area += child->Area;

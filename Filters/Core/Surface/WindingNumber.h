@@ -99,10 +99,32 @@ private:
     Index Id;
   };
   Index BuildNode(Index begin, Index end, std::vector<Item>& items);
-  /// A top tree over the cube roots roots[begin, end) (sorted by key; ties of the median by key).
-  Index BuildTop(std::vector<Index>& roots, size_t begin, size_t end);
-  /// The moments of `node` from its two children's.
-  void Combine(Node& node) const;
+  /// A leaf of the top tree: a cube's root this process built (Held, an index in Nodes) or the gathered record of
+  /// another process' cube (Record: centre, moment, second, third, radius, area).
+  struct TopLeaf
+  {
+    Index Held = -1;
+    const double* Record = nullptr;
+  };
+  struct TopShape
+  {
+    double Centre[3];
+    double Radius;
+    double Area;
+  };
+  TopShape LeafShape(const TopLeaf& leaf) const;
+  Node LeafNode(const TopLeaf& leaf) const;
+  /// The top tree's internal nodes' shapes over leaves[begin, end), in pre-order from `index` (ordering the leaves
+  /// by the splits: median of the centres along the widest axis, ties in key order).
+  TopShape ShapeTop(std::vector<TopLeaf>& leaves, size_t begin, size_t end, size_t index,
+    std::vector<TopShape>& shapes) const;
+  /// The moments of the top node over leaves[begin, end), not stored.
+  Node TopMoments(const std::vector<TopLeaf>& leaves, size_t begin, size_t end) const;
+  /// Stores the top node over leaves[begin, end) and the descendants this process needs (d: see the definition).
+  Index EmitTop(const std::vector<TopLeaf>& leaves, size_t begin, size_t end, size_t index,
+    const std::vector<TopShape>& shapes, const Distribution* d);
+  /// `node`'s moments from its two children's.
+  void Combine(Node& node, const Node& left, const Node& right) const;
   std::vector<Node> Nodes;
   Index Root = 0;
   double BuildShortfall = -HUGE_VAL;
