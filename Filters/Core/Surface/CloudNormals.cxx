@@ -157,25 +157,15 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
   }
   grid.Build(xyz, n);
   UniqueCloud unique;
+  std::unique_ptr<DistinctDistribution> processes;
   // Whether any process has duplicates: then all compute on their distinct points (collectively).
-  const bool merged = MergeDuplicates(grid, xyz, referenceNormals, unique);
-  if (GlobalMax(d, merged ? 1.0 : 0.0) > 0.0)
+  if (MergeDuplicates(grid, xyz, referenceNormals, n, d, unique, processes, unique.Duplicates))
   {
-    if (!merged)
-    {
-      MergeDuplicates(grid, xyz, referenceNormals, unique, true); // this process has none: its points as they are
-    }
     // Computed on the distinct points, in the same frame; every duplicate gets its representative's results.
     CloudNormalsOptions distinctOptions = options;
     distinctOptions.Framed = true;
     grid.GetFrame(distinctOptions.FrameBounds, distinctOptions.FramePoints);
-    std::unique_ptr<DistinctDistribution> processes;
-    if (d)
-    {
-      processes.reset(new DistinctDistribution(*d, unique, n));
-      distinctOptions.Neighborhood.Processes = processes.get();
-      unique.Duplicates = processes->OwnDuplicates();
-    }
+    distinctOptions.Neighborhood.Processes = processes ? processes.get() : d;
     CloudNormalsResult distinct;
     const bool done = ComputeCloudNormals(unique.Points.data(), static_cast<Index>(unique.Points.size() / 3),
       referenceNormals ? unique.Normals.data() : nullptr, distinctOptions, distinct, progress);

@@ -385,20 +385,10 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   const Distribution* d = processes;
   if (options.Method != SurfaceMethod::SPH)
   {
-    const bool merged = MergeDuplicates(grid, input.Points, input.Normals, unique);
-    if (GlobalMax(processes, merged ? 1.0 : 0.0) > 0.0)
+    if (MergeDuplicates(grid, input.Points, input.Normals, input.Count, processes, unique, distinctProcesses,
+          report.Duplicates))
     {
-      if (!merged)
-      {
-        MergeDuplicates(grid, input.Points, input.Normals, unique, true);
-      }
-      report.Duplicates = unique.Duplicates;
-      if (processes)
-      {
-        distinctProcesses.reset(new DistinctDistribution(*processes, unique, input.Count));
-        d = distinctProcesses.get();
-        report.Duplicates = distinctProcesses->OwnDuplicates();
-      }
+      d = distinctProcesses ? distinctProcesses.get() : processes;
       distinct.Points = unique.Points.data();
       distinct.Count = static_cast<Index>(unique.Points.size() / 3);
       distinct.Normals = input.Normals ? unique.Normals.data() : nullptr;

@@ -88,4 +88,25 @@ Index DistinctDistribution::OwnDuplicates() const
   return count;
 }
 
+bool MergeDuplicates(const NeighborGrid& grid, const double* xyz, const double* normals, Index n, const Distribution* d,
+  UniqueCloud& unique, std::unique_ptr<DistinctDistribution>& processes, Index& duplicates)
+{
+  const bool merged = MergeDuplicates(grid, xyz, normals, unique);
+  if (!(GlobalMax(d, merged ? 1.0 : 0.0) > 0.0))
+  {
+    return false;
+  }
+  if (!merged)
+  {
+    MergeDuplicates(grid, xyz, normals, unique, true); // this process has none: its points as they are
+  }
+  duplicates = unique.Duplicates;
+  if (d)
+  {
+    processes.reset(new DistinctDistribution(*d, unique, n));
+    duplicates = processes->OwnDuplicates();
+  }
+  return true;
+}
+
 } // namespace meshfree

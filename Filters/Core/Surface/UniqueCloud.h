@@ -9,6 +9,7 @@
 #include "Common/Distribution.h"
 #include "Common/NeighborGrid.h"
 
+#include <memory>
 #include <vector>
 
 namespace meshfree
@@ -59,6 +60,13 @@ private:
   const UniqueCloud& Unique;
   std::vector<Index> Representative;
 };
+
+/// MergeDuplicates over a cloud that may be distributed (d; collective): when any process has duplicates, every
+/// process fills `unique` (with its points as they are when it has none), distributed with `processes` wrapping
+/// `d` (so the surface and the normals see one distinct cloud), and `duplicates` counts the duplicates this
+/// process owns (serial: all of them). Returns false, leaving the outputs untouched, when no process has any.
+bool MergeDuplicates(const NeighborGrid& grid, const double* xyz, const double* normals, Index n, const Distribution* d,
+  UniqueCloud& unique, std::unique_ptr<DistinctDistribution>& processes, Index& duplicates);
 
 } // namespace meshfree
 
