@@ -584,6 +584,16 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
   }
   start = Clock::now();
   report.ProjectedVertices = ProjectVertices(*field, lattice.CellSize, options.ProjectVertices, mesh);
+  // The field's last evaluation: its shortfall is final, and the fits and the winding number's tree go before the
+  // distances and the pieces (the memory they take would add to theirs).
+  if (d && report.HolesFilled)
+  {
+    report.Shortfall = std::max(report.Shortfall, static_cast<const FilledField&>(*field).Shortfall());
+  }
+  field.reset();
+  fit.reset();
+  std::vector<double>().swap(support);
+  std::vector<double>().swap(areas);
   std::vector<Index> nearest;
   DistanceToData(grid, mesh.Points, mesh.DistanceToData, nearest, d);
   if (options.Method != SurfaceMethod::SPH)
@@ -627,10 +637,6 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     }
   }
   report.ProjectionSeconds = seconds(start);
-  if (d && report.HolesFilled)
-  {
-    report.Shortfall = std::max(report.Shortfall, static_cast<const FilledField&>(*field).Shortfall());
-  }
   if (progress && !progress(1.0))
   {
     report.Aborted = true;
