@@ -8,7 +8,8 @@
 // a solve changes the velocities by dv_i = sum_j (P_i / rho_i + P_j / rho_j) G_ij + sum_b 2 (P_i / rho_i) G_ib, and
 // the density rate it controls is Drho/Dt_i = -sum_j (v_i - v_j) . G_ij - sum_b 2 v_i . G_ib (below: the adjoint).
 // Per step, from (x, v):
-//  1. neighbour lists at x; density rho_i (the kernel sum, wall dummies included) and the factor
+//  1. neighbour lists at x (at the first step of an Advance() call those the last call's output computed, when the
+//     state is bit for bit the one it output); density rho_i (the kernel sum, wall dummies included) and the factor
 //     alpha_i = rho_i / (|sum_f G + 2 sum_b G|^2 + sum_f |G_ij|^2) (Bender & Koschier's factor with the mirrored
 //     walls), the exact response of the
 //     particle's own density rate to its own P, bounded below by a tenth of an interior particle's value (a
