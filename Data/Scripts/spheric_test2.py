@@ -8,6 +8,18 @@ Probes:
   pressures P1-P4 on the box's front face (x = 0.8245, y = 0.471, z = 0.021, 0.061, 0.101, 0.141 m) and P5-P8 on
   its top (z = 0.161, y = 0.471, x = 0.8035, 0.7635, 0.7235, 0.6835 m).
 The column is placed on the tank's lattice (its length rounded to a whole number of spacings from the far wall).
+The source fills a block with whole layers of a cubic lattice of spacing dx, so the column is the specification's
+only where 0.55 / dx and 1 / dx are whole numbers, i.e. dx = 0.05 / k (0.05, 0.025, 0.0167, 0.0125 m; its length
+then within dx / 2 of 1.228 m: 1.225 m at dx = 0.025). At dx = 0.04 and 0.02 m it is 0.56 m tall, at 0.03 m 0.54 m
+tall and 0.99 m wide (column_size() gives it; the CSV header records it and run() warns): a 1 cm error in the height
+shifts the reservoir's drain at H4 by about 8 ms (results/spheric2.md). A lattice fitted per axis would need the
+kernels' lattice corrections and the wall dummies' mass redone for it (the kernel sum of a lattice stretched to fit,
+mass from its own volume per particle, is 0.6 % off rho0 at dx = 0.04 and 0.03 m (below, above), 60 times DFSPH's
+density tolerance, with the spiky kernel and h = 2 dx): not done.
+Gauge labels: the experiment's file cited in Testing/Benchmarks/bench_spheric2.py labels as H1 a gauge that is wet
+from t = 0.185 s (0.07-0.09 m at 0.30-0.38 s) and as H3 one that stays dry (under 1 mm) while H2 fills from 0.350 s:
+its H1 is the gauge at x = 1.488 m and its H3 the one at x = 0.496 m, the reverse of the labels here (checked
+2026-12-03). H2 and H4, the ones compared, are the same in both.
 Estimators (this script's choices, recorded in the CSV header): a water height is the water depth at the gauge, the
 particles' volume dx^3 spread by a tent of half-width 2 dx in x and in y (a splash adds its volume, not its
 height); a pressure is the Shepard (kernel-weighted) average of the particle pressures within the support radius h = 2 dx
@@ -19,8 +31,10 @@ Run from pvpython (plugin from $MESHFREE_PLUGIN):
   pvpython --no-mpi Data/Scripts/spheric_test2.py --dx 0.04 --end 6 --solver DFSPH --out spheric2_dx0.04.csv
 or from the GUI: View > Python Shell > Run Script (with the MeshFree plugin loaded). Without command-line options
 the script runs a coarse 1 s variant (dx = 0.04 m, DFSPH), shows the fluid and writes ~/spheric2.csv.
-Output: a CSV with one row per output time: t, H1..H4 (m), P1..P8 (Pa), particles, steps taken and wall-clock
-seconds so far.
+Output: a CSV with one row per output time: t, H1..H4 (m), P1..P8 (Pa), particles, steps taken, wall-clock and
+CPU seconds so far (CPU: all threads of the process, the cost measure less sensitive to a shared machine's load),
+and with DFSPH the solves' iterations per step over the interval. --set NAME=VALUE sets further SPH Fluid
+properties (e.g. --set CFLNumber=0.4 TimeStep=0.005, the time-to-solution front in results/spheric2.md).
 """
 import argparse
 import csv
@@ -46,6 +60,14 @@ SENSORS = {
 }
 
 
+def column_size(dx):
+    """(length, width, height) of the water column the source builds at spacing dx: whole lattice layers (SPH Fluid
+    fills [lo, hi] with round((hi - lo) / dx) nodes per axis), the length as make_scene() rounds it."""
+    layers = [round((WATER[1] - WATER[0]) / dx), int(np.floor((WATER[3] - WATER[2]) / dx + 0.5)),
+              int(np.floor((WATER[5] - WATER[4]) / dx + 0.5))]
+    return tuple(n * dx for n in layers)
+
+
 def load_plugin(namespace):
     """Makes SPHFluidWithObstacles available in `namespace`: already there, in paraview.simple (the GUI, with the
     plugin loaded), or loaded from $MESHFREE_PLUGIN."""
@@ -63,8 +85,9 @@ def load_plugin(namespace):
         namespace["SPHFluidWithObstacles"] = simple.SPHFluidWithObstacles
 
 
-def make_scene(namespace, dx, end, interval, solver, viscosity=1e-3):
-    """The Test 2 scene as an SPH Fluid With Obstacles proxy (and the box source it flows around)."""
+def make_scene(namespace, dx, end, interval, solver, viscosity=1e-3, properties=None):
+    """The Test 2 scene as an SPH Fluid With Obstacles proxy (and the box source it flows around). `properties`:
+    further proxy properties by name (e.g. {"CFLNumber": 0.5, "TimeStep": 0.005}), set last."""
     box = simple.Box(XLength=BOX[1] - BOX[0], YLength=BOX[3] - BOX[2], ZLength=BOX[5] - BOX[4],
                      Center=[0.5 * (BOX[0] + BOX[1]), 0.5 * (BOX[2] + BOX[3]), 0.5 * (BOX[4] + BOX[5])])
     surface = simple.Triangulate(Input=box)
@@ -81,6 +104,8 @@ def make_scene(namespace, dx, end, interval, solver, viscosity=1e-3):
     fluid.EndTime = end
     fluid.OutputInterval = interval
     fluid.CacheSize = 2  # the probes are read as the run goes: no need to keep states
+    for name, value in (properties or {}).items():
+        setattr(fluid, name, value)
     return fluid
 
 
@@ -109,13 +134,19 @@ def probes(out, dx):
     return row
 
 
-def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True):
-    fluid = make_scene(namespace, dx, end, interval, solver)
+def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True, properties=None):
+    size = column_size(dx)
+    spec = (WATER[1] - WATER[0], WATER[3] - WATER[2], WATER[5] - WATER[4])
+    if abs(size[1] - spec[1]) > 1e-3 or abs(size[2] - spec[2]) > 1e-3:
+        print("warning: at dx = %g m the water column is %.4f x %.4f x %.4f m (the specification's: %g x %g x %g m; "
+              "exact where dx = 0.05 / k, e.g. 0.025 m)" % ((dx,) + size + spec), flush=True)
+    fluid = make_scene(namespace, dx, end, interval, solver, properties=properties)
     fluid.UpdatePipelineInformation()  # the output times of these properties, not of the defaults
     times = list(fluid.TimestepValues)
     names = list(GAUGES) + list(SENSORS)
     rows = []
     start = time.time()
+    cpu_start = time.process_time()
     for t in times:
         fluid.UpdatePipeline(t)
         out = dsa.WrapDataObject(sm.Fetch(fluid))
@@ -124,17 +155,27 @@ def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True
         row["particles"] = out.GetNumberOfPoints()
         fluid.UpdatePropertyInformation()
         row["steps"] = fluid.GetProperty("StepsTaken").GetElement(0)
+        for name, key in (("DensityIterations", "density_iterations"), ("DivergenceIterations",
+                                                                      "divergence_iterations")):
+            # DFSPH: the solves' iterations per step over the interval that produced this output (0 for WCSPH)
+            array = out.FieldData[name] if name in out.FieldData.keys() else None
+            row[key] = float(array[1]) if array is not None and len(array) > 1 else 0.0
         row["wall_s"] = time.time() - start
+        row["cpu_s"] = time.process_time() - cpu_start  # all threads of this process: less sensitive to load
         rows.append(row)
         if progress:
             print("t = %.3f s  H2 = %.3f  H4 = %.3f  P1 = %.0f Pa  (%.0f s)" % (t, row["H2"], row["H4"], row["P1"],
                                                                              row["wall_s"]), flush=True)
     if out_csv:
         with open(out_csv, "w", newline="") as f:
-            f.write("# SPHERIC Test 2 with MeshFree SPH Fluid: dx = %g m, solver %s, viscosity 1e-3 Pa s\n" % (dx, solver))
+            f.write("# SPHERIC Test 2 with MeshFree SPH Fluid: dx = %g m, solver %s, viscosity 1e-3 Pa s%s\n" % (
+                dx, solver, "".join(", %s %s" % (k, v) for k, v in (properties or {}).items())))
+            f.write("# water column %.4f x %.4f x %.4f m (whole lattice layers; the specification's 1.228 x 1 x 0.55)\n"
+                    % size)
             f.write("# heights: particle volume spread by a tent of half-width 2 dx in x and y around the gauge; "
                     "pressures: Shepard average within h = 2 dx of the probe moved dx/2 into the fluid\n")
-            w = csv.DictWriter(f, fieldnames=["t"] + names + ["particles", "steps", "wall_s"])
+            w = csv.DictWriter(f, fieldnames=["t"] + names + ["particles", "steps", "wall_s", "cpu_s",
+                                                          "density_iterations", "divergence_iterations"])
             w.writeheader()
             for row in rows:
                 w.writerow(row)
@@ -156,9 +197,23 @@ def main():
     parser.add_argument("--interval", type=float, default=0.02)
     parser.add_argument("--solver", default="DFSPH", choices=["WCSPH", "DFSPH"])
     parser.add_argument("--out", default="spheric2.csv")
+    parser.add_argument("--set", nargs="+", default=[], metavar="NAME=VALUE",
+                        help="further SPH Fluid properties, e.g. --set CFLNumber=0.5 TimeStep=0.005")
     args = parser.parse_args()
     load_plugin(globals())
-    run(globals(), args.dx, args.end, args.interval, args.solver, args.out)
+    run(globals(), args.dx, args.end, args.interval, args.solver, args.out, properties=parse_properties(args.set))
+
+
+def parse_properties(items):
+    """{"CFLNumber": 0.5, ...} from ["CFLNumber=0.5", ...] (numbers as floats, anything else as text)."""
+    properties = {}
+    for item in items:
+        name, _, value = item.partition("=")
+        try:
+            properties[name] = float(value)
+        except ValueError:
+            properties[name] = value
+    return properties
 
 
 if __name__ == "__main__":

@@ -138,6 +138,12 @@ def metrics(rows, end, interval):
     out["mass_drift"] = abs(rows[-1]["particles"] - rows[0]["particles"]) / max(1, rows[0]["particles"])
     out["steps"] = rows[-1].get("steps")
     out["wall_s"] = rows[-1]["wall_s"]
+    out["cpu_s"] = rows[-1].get("cpu_s")
+    # DFSPH: the solves' iterations per step over the run (each output's per-step mean weighted by its steps)
+    if "density_iterations" in rows[0] and rows[-1].get("steps"):
+        steps = np.diff(np.array([0.0] + [r["steps"] for r in rows]))
+        for key in ("density_iterations", "divergence_iterations"):
+            out[key] = float(np.sum(steps * np.array([r[key] for r in rows])) / rows[-1]["steps"])
     out["sim_per_wall"] = float(t[-1] / rows[-1]["wall_s"]) if rows[-1]["wall_s"] > 0 else None
     return out
 
@@ -191,15 +197,16 @@ def plot(runs, out_dir, interval=0.01):
 
 
 def read_csv(path):
-    """The rows, solver and dx of a probe series written by spheric_test2.run()."""
+    """The rows, solver, dx and further settings (text) of a probe series written by spheric_test2.run()."""
     import csv
     with open(path) as f:
         first = f.readline()
         lines = [line for line in f if not line.startswith("#")]
     solver = "DFSPH" if "solver DFSPH" in first else "WCSPH"
     dx = float(first.split("dx = ")[1].split(" m")[0])
+    settings = first.split("Pa s")[1].strip().lstrip(",").strip() if "Pa s" in first else ""
     rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(lines)]
-    return rows, solver, dx
+    return rows, solver, dx, settings
 
 
 def main():
@@ -210,6 +217,10 @@ def main():
     parser.add_argument("--solvers", nargs="+", default=["DFSPH", "WCSPH"])
     parser.add_argument("--out", default="spheric2_results")
     parser.add_argument("--progress", action="store_true", help="print the probes at every output time as it goes")
+    parser.add_argument("--set", nargs="+", default=[], metavar="NAME=VALUE",
+                        help="further SPH Fluid properties for every run, e.g. --set CFLNumber=0.5 TimeStep=0.005 "
+                             "(the time-to-solution front: results/spheric2.md)")
+    parser.add_argument("--tag", default="", help="appended to the probe series' file names (runs with --set)")
     parser.add_argument("--from-csv", nargs="+", default=None,
                         help="no simulation: the table and the picture of these probe series (written by earlier "
                              "runs of this script), e.g. runs at several resolutions made one at a time")
@@ -218,9 +229,9 @@ def main():
     runs, table = [], []
     if args.from_csv:
         for path in args.from_csv:
-            rows, solver, dx = read_csv(path)
+            rows, solver, dx, settings = read_csv(path)
             m = metrics(rows, rows[-1]["t"], args.interval)
-            m.update({"solver": solver, "dx": dx, "end": rows[-1]["t"], "load": None})
+            m.update({"solver": solver, "dx": dx, "end": rows[-1]["t"], "load": None, "settings": settings})
             runs.append(("%s dx=%g" % (solver, dx), rows))
             table.append(m)
     else:
@@ -228,11 +239,14 @@ def main():
         spheric_test2.load_plugin(ns)
     for dx in ([] if args.from_csv else args.dx):
         for solver in args.solvers:
-            csv_path = os.path.join(args.out, "spheric2_%s_dx%g.csv" % (solver, dx))
-            print("== %s, dx = %g m, %g s" % (solver, dx, args.end), flush=True)
-            rows = spheric_test2.run(ns, dx, args.end, args.interval, solver, csv_path, progress=args.progress)
+            csv_path = os.path.join(args.out, "spheric2_%s_dx%g%s.csv" % (solver, dx, args.tag))
+            properties = spheric_test2.parse_properties(args.set)
+            print("== %s, dx = %g m, %g s %s" % (solver, dx, args.end, properties), flush=True)
+            rows = spheric_test2.run(ns, dx, args.end, args.interval, solver, csv_path, progress=args.progress,
+                                     properties=properties)
             m = metrics(rows, args.end, args.interval)
-            m.update({"solver": solver, "dx": dx, "end": args.end, "load": list(os.getloadavg())})
+            m.update({"solver": solver, "dx": dx, "end": args.end, "load": list(os.getloadavg()),
+                      "settings": ", ".join("%s %s" % (k, v) for k, v in properties.items())})
             print(json.dumps(m), flush=True)
             runs.append(("%s dx=%g" % (solver, dx), rows))
             table.append(m)
@@ -263,6 +277,20 @@ def main():
                     EXPERIMENT_P1_PEAK[1] / 1000.0, EXPERIMENT_P1_PEAK[0], experiment_window_peak(args.interval)[1]
                     / 1000.0, experiment_window_peak(args.interval)[0], args.interval, EXPERIMENT_P1_ARRIVAL,
                     EXPERIMENT_P1_CALM[0], EXPERIMENT_P1_CALM[1], EXPERIMENT_P1_CALM[2] / 1000.0, len(EXPERIMENT_H)))
+        f.write("\nTime to solution (the front: wall-clock and CPU seconds of the whole run, probes included; CPU: all "
+                "threads of the process, less sensitive to the machine's load):\n\n"
+                "| solver | settings | dx (m) | simulated s | steps | iterations per step (density / divergence) | wall s "
+                "| CPU s | simulated s / wall s | H2 nMAE | H4 nMAE | load average (1, 5, 15 min) at the end |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+        for m in table:
+            f.write("| %s | %s | %g | %g | %s | %s | %.0f | %s | %.4f | %.1f %% | %.1f %% | %s |\n" % (
+                m["solver"], m.get("settings") or "defaults", m["dx"], m["end"],
+                "%d" % m["steps"] if m.get("steps") is not None else "-",
+                "%.2f / %.2f" % (m["density_iterations"], m["divergence_iterations"])
+                if m["solver"] == "DFSPH" and "density_iterations" in m else "-", m["wall_s"],
+                "%.0f" % m["cpu_s"] if m.get("cpu_s") is not None else "-", m["sim_per_wall"] or 0.0,
+                100 * m["H2_nmae"], 100 * m["H4_nmae"],
+                " ".join("%.1f" % x for x in m["load"]) if m.get("load") else "-"))
     plot(runs, args.out, args.interval)
     print(open(os.path.join(args.out, "spheric2.md")).read())
 

@@ -241,6 +241,37 @@ TEST(SPHDivergenceFree, CopiedStateContinuesBitForBit)
   EXPECT_EQ(s.DensityStiffness.size(), static_cast<std::size_t>(s.Size()));
 }
 
+TEST(SPHDivergenceFree, FieldsOfTheLastOutputAreReusedOnlyForThatState)
+{
+  // The first step of an Advance() reuses the fields (neighbour lists, density, gradients) that the last call's
+  // output computed, when the state it starts from has the same positions and densities. Without a reorder at
+  // the start of the call (ReorderInterval larger than the run) that path is taken: it must give the bits of a
+  // solver that computes them afresh; and a solver handed an older state (a cache restore into the same object)
+  // must not reuse the newer state's fields.
+  for (int dimension : { 2, 3 })
+  {
+    SPHParameters p = SmallScene(dimension);
+    p.ReorderInterval = 100000;
+    SPHFluid a, fresh;
+    a.Setup(p);
+    fresh.Setup(p);
+    SPHState s = a.InitialState();
+    ASSERT_EQ(a.Advance(s, 0.03), SPHFluid::Status::Ok) << a.ErrorMessage();
+    const SPHState older = s;
+    ASSERT_EQ(a.Advance(s, 0.06), SPHFluid::Status::Ok); // reuses the fields of the output at 0.03
+    SPHState reference = older;
+    ASSERT_EQ(fresh.Advance(reference, 0.06), SPHFluid::Status::Ok); // computes them
+    EXPECT_EQ(reference.Position, s.Position) << dimension << "D";
+    EXPECT_EQ(reference.Velocity, s.Velocity) << dimension << "D";
+    EXPECT_EQ(reference.Pressure, s.Pressure) << dimension << "D";
+    SPHState again = older; // a holds the fields of the state at 0.06 now
+    ASSERT_EQ(a.Advance(again, 0.06), SPHFluid::Status::Ok);
+    EXPECT_EQ(again.Position, s.Position) << dimension << "D";
+    EXPECT_EQ(again.Velocity, s.Velocity) << dimension << "D";
+    EXPECT_EQ(again.Pressure, s.Pressure) << dimension << "D";
+  }
+}
+
 TEST(SPHDivergenceFree, StiffnessIsPartOfTheState)
 {
   // The warm-start stiffness changes the continuation, so a cache that dropped it would not reproduce the run.

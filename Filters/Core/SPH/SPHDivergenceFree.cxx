@@ -8,7 +8,8 @@
 // a solve changes the velocities by dv_i = sum_j (P_i / rho_i + P_j / rho_j) G_ij + sum_b 2 (P_i / rho_i) G_ib, and
 // the density rate it controls is Drho/Dt_i = -sum_j (v_i - v_j) . G_ij - sum_b 2 v_i . G_ib (below: the adjoint).
 // Per step, from (x, v):
-//  1. neighbour lists at x; density rho_i (the kernel sum, wall dummies included) and the factor
+//  1. neighbour lists at x (at the first step of an Advance() call those the last call's output computed, when the
+//     state is bit for bit the one it output); density rho_i (the kernel sum, wall dummies included) and the factor
 //     alpha_i = rho_i / (|sum_f G + 2 sum_b G|^2 + sum_f |G_ij|^2) (Bender & Koschier's factor with the mirrored
 //     walls), the exact response of the
 //     particle's own density rate to its own P, bounded below by a tenth of an interior particle's value (a
@@ -171,6 +172,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -186,8 +188,19 @@ constexpr double ReductionFloor = 0.01;   // ... unless its average error is bel
 constexpr int SmoothingShape = 0;         // the Pressure output's Shepard weights: poly6's shape (h^2 - r^2)^3
 }
 
+bool SPHFluid::FieldsMatch(const SPHState& state) const
+{
+  // Bit for bit (memcmp, not ==: -0 and 0 differ here as they may in the sums).
+  const std::size_t n = state.Position.size();
+  return !this->FieldsPosition.empty() && this->FieldsPosition.size() == n &&
+    this->FieldsDensity.size() == state.Density.size() && 3 * state.Density.size() == n &&
+    std::memcmp(this->FieldsPosition.data(), state.Position.data(), n * sizeof(double)) == 0 &&
+    std::memcmp(this->FieldsDensity.data(), state.Density.data(), state.Density.size() * sizeof(double)) == 0;
+}
+
 void SPHFluid::DivergenceFreeFields(SPHState& state)
 {
+  this->InvalidateFields();
   const Index n = state.Size();
   this->Grid.SetCellsByPosition(false);
   this->Grid.Build(state.Position.data(), n, this->H);
@@ -714,6 +727,8 @@ void SPHFluid::DivergenceFreeOutput(SPHState& state)
     return;
   }
   this->DivergenceFreeFields(state);
+  this->FieldsPosition = state.Position; // the next Advance()'s first step starts from these fields
+  this->FieldsDensity = state.Density;
   // The pressure the fluid felt over the Advance() call that produced the state (the source's output interval):
   // each particle's pressure impulse over those steps, sum of dt rho (kappa_density + kappa_divergence), over their
   // time span, Shepard-averaged over the neighbourhood ("Pressure output" in the header). Without steps (the
@@ -759,7 +774,12 @@ SPHFluid::Status SPHFluid::AdvanceDivergenceFree(SPHState& state, double targetT
     {
       this->Reorder(state);
     }
-    this->DivergenceFreeFields(state);
+    // The first step of a call starts where the last call's output left the fields, unless the state differs (a
+    // state restored from a cache, a reorder above): computed once, not twice, per output interval.
+    if (steps > 0 || !this->FieldsMatch(state))
+    {
+      this->DivergenceFreeFields(state);
+    }
     double dt;
     bool last;
     if (!this->ChooseDivergenceFreeStep(state, state.Time, targetTime, steps, dt, last))

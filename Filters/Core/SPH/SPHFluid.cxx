@@ -93,6 +93,7 @@ void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
 
 void SPHFluid::ComputeAccelerations(SPHState& state)
 {
+  this->InvalidateFields();
   const Index n = state.Size();
   if (n == 0)
   {
@@ -250,6 +251,7 @@ void SPHFluid::Enforce(SPHState& state, Index begin, Index end) const
 
 void SPHFluid::Reorder(SPHState& state)
 {
+  this->InvalidateFields();
   const Index n = state.Size();
   this->Grid.SetCellsByPosition(false); // the particles' own order: the CUDA integrator rebuilds it (SPHDevice.h)
   this->Grid.Build(state.Position.data(), n, this->H);
@@ -465,6 +467,7 @@ SPHFluid::Status SPHFluid::Advance(SPHState& state, double targetTime, const Pro
 
 std::vector<int> SPHFluid::NeighborCounts(const SPHState& state)
 {
+  this->InvalidateFields();
   const Index n = state.Size();
   std::vector<int> counts(n, 0);
   if (n == 0)

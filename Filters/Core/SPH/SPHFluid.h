@@ -322,6 +322,17 @@ private:
   // and wall neighbours, relative to the lattice's (DivergenceFreeFields): the Pressure output is gamma p.
   std::vector<double> GradientStrength;
   double PressureImpulseTime = 0.0;
+  // DFSPH: the positions and densities at which DivergenceFreeOutput last computed the per-step fields (grid,
+  // neighbour lists, density, pair gradients, alpha, gradient strength); empty once anything else has rebuilt the
+  // grid or the lists. The first step of the next Advance() reuses those fields when the state it starts from has
+  // the same bits (the fields are a function of the positions alone), instead of computing them a second time.
+  std::vector<double> FieldsPosition, FieldsDensity;
+  void InvalidateFields()
+  {
+    this->FieldsPosition.clear();
+    this->FieldsDensity.clear();
+  }
+  bool FieldsMatch(const SPHState& state) const;
   std::vector<double> SolveResidual, SolveDirection, SolvePreconditioned, SolveProduct, SolveVelocity; // the CG's
   std::vector<char> SolveFree;
   void SmoothStiffness(const SPHState& state, const std::vector<double>& in, std::vector<double>& out) const;

@@ -72,6 +72,7 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
   this->Error.clear();
   this->ReducedStepCount = 0;
   this->UnconvergedStepCount = 0;
+  this->InvalidateFields();
   auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
   if (p.Dimension != 2 && p.Dimension != 3)
   {
