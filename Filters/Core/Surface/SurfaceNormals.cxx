@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -42,11 +43,10 @@ constexpr double MaxCrossing = 0.2;
 constexpr double NoiseAgreement = 1.5; // the jets' noise at most this many times the PCA spread's (thin parts)
 constexpr double MaxTurn = 0.2; // radians: the most the curvature may turn the normal between a point and its donor
 constexpr Index SamplePoints = 2048; // the scale's sample (CloudSample: by a hash of the positions)
-// The wide jets' thinned cloud (BuildThinnedCloud): used when the normals' radius holds on average more than ThinAbove
-// points, thinned to about ThinTarget of them; a point whose thinned neighbourhood holds fewer than ThinFloor
-// (a sparse region) fits over the whole cloud's.
-constexpr double ThinAbove = 400.0;
-constexpr double ThinTarget = 272.0;
+// The wide jets' thinned clouds (BuildThinnedClouds): floor(n / ThinTarget) of them when the normals' radius holds
+// on average n >= 2 ThinTarget points; a point whose thinned neighbourhood holds fewer than ThinFloor (a sparse
+// region) fits over the whole cloud's.
+constexpr double ThinTarget = 250.0;
 constexpr size_t ThinFloor = MaxFit / 2;
 constexpr size_t MaxThinFit = 320; // a thinned list (evenly spread already) is fitted whole up to this many
 
@@ -683,16 +683,36 @@ bool JetResidual(const double* sorted, const Index* pos, size_t count, const dou
   return std::isfinite(residual);
 }
 
-/// The wide jets' thinned cloud: where the normals' radius holds far more points than a jet fits (MaxFit; at 1M and
-/// 10M points of a noisy scan about 1000), the jets are fitted over a fraction of the points, in a grid of their own,
-/// so that a query filters that fraction of the candidates. The fraction is taken in every cell of `grid` alike:
-/// its points (sorted by position) at the steps of `fraction` along them, as the jets' own subset (SpreadSubset)
-/// steps along a list in cell order; a random fraction (by a hash of the positions) was measured less accurate (the
-/// count per cell then varies). The selection depends on the cell's points alone: the same whatever the order and
-/// the split of the cloud, when the cell is whole (a distributed query's reach grows by a cell's diagonal). The grid
-/// is laid out from the whole cloud's frame (the same cells on every process), its cells 1 / sqrt(fraction) times
-/// as wide (as many points per cell on a surface). False (thin left empty) when it would hold no point.
-bool BuildThinnedCloud(const NeighborGrid& grid, double fraction, NeighborGrid& thin, std::vector<double>& xyz)
+/// A hash of a position's coordinates (+0 and -0 alike): which thinned cloud a point's jet uses.
+std::uint64_t PositionHash(const double x[3])
+{
+  std::uint64_t h = 0x243f6a8885a308d3ull;
+  for (int a = 0; a < 3; ++a)
+  {
+    const double v = x[a] == 0.0 ? 0.0 : x[a];
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    h = (h ^ bits) * 0x9e3779b97f4a7c15ull;
+    h ^= h >> 29;
+    h *= 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 32;
+  }
+  return h;
+}
+
+/// The wide jets' thinned clouds: where the normals' radius holds far more points than a jet fits (MaxFit; at 1M
+/// and 10M points of a noisy scan about 1000), each jet is fitted over one of `classes` thinned clouds, so that a
+/// query filters that fraction of the candidates. The classes partition every cell of `grid`: its points (sorted
+/// by position) in turn, from a phase set by the cell's coordinates, as the jets' own subset (SpreadSubset) steps
+/// along a list in cell order (a random fraction, by a hash of the positions, was measured less accurate: the count
+/// per cell then varies). A point's jet uses the class its position hashes to, so that neighbouring points fit
+/// different subsets: their curvatures' noise stays independent and the smoothing takes it out (one shared thinned
+/// cloud made the smoothed curvature's error 10-45 % larger). The selection depends on the cell's points alone:
+/// the same whatever the order and the split of the cloud when the cell is whole (a distributed query's reach grows
+/// by a cell's diagonal). Each class' grid is laid out from the whole cloud's frame (the same cells on every
+/// process), its cells sqrt(classes) times as wide (as many points per cell on a surface). False when a class is
+/// empty.
+bool BuildThinnedClouds(const NeighborGrid& grid, int classes, std::vector<NeighborGrid>& thin)
 {
   const Index nv = grid.NumberOfValidPoints();
   const double* sorted = grid.SortedPoints();
@@ -707,7 +727,11 @@ bool BuildThinnedCloud(const NeighborGrid& grid, double fraction, NeighborGrid& 
       cell[a] = GridAxisCell(sorted[3 * s + a] - bounds[2 * a], inverse, dims[a]);
     }
   };
-  xyz.clear();
+  std::vector<std::vector<double>> xyz(static_cast<size_t>(classes));
+  for (std::vector<double>& c : xyz)
+  {
+    c.reserve(static_cast<size_t>(3 * (nv / classes + 1)));
+  }
   Index begin = 0, first[3] = { 0, 0, 0 };
   if (nv > 0)
   {
@@ -724,24 +748,29 @@ bool BuildThinnedCloud(const NeighborGrid& grid, double fraction, NeighborGrid& 
     {
       continue; // s is not the last point of its cell
     }
-    // The cell [begin, s]: its point j is kept where floor(j fraction + 1/2) steps.
-    for (Index j = 0; j <= s - begin; ++j)
+    // The cell [begin, s]: its points dealt to the classes in turn.
+    const Index phase = (first[0] + 3 * first[1] + 7 * first[2]) % classes;
+    for (Index j = begin; j <= s; ++j)
     {
-      const double at = static_cast<double>(j) * fraction + 0.5;
-      if (std::floor(at + fraction) > std::floor(at))
-      {
-        xyz.insert(xyz.end(), sorted + 3 * (begin + j), sorted + 3 * (begin + j) + 3);
-      }
+      std::vector<double>& c = xyz[static_cast<size_t>((j - begin + phase) % classes)];
+      c.insert(c.end(), sorted + 3 * j, sorted + 3 * j + 3);
     }
     begin = s + 1;
     std::copy(next, next + 3, first);
   }
-  if (xyz.empty())
+  thin.assign(static_cast<size_t>(classes), NeighborGrid());
+  for (int c = 0; c < classes; ++c)
   {
-    return false;
+    thin[c].SetFrame(bounds, std::max<Index>(1, framePoints / classes));
+    if (!thin[c].Build(xyz[c].data(), static_cast<Index>(xyz[c].size() / 3),
+          grid.CellSize() * std::sqrt(static_cast<double>(classes))))
+    {
+      thin.clear();
+      return false;
+    }
+    std::vector<double>().swap(xyz[c]);
   }
-  thin.SetFrame(bounds, std::max<Index>(1, static_cast<Index>(std::llround(fraction * static_cast<double>(framePoints)))));
-  return thin.Build(xyz.data(), static_cast<Index>(xyz.size() / 3), grid.CellSize() / std::sqrt(fraction));
+  return true;
 }
 
 /// From a radius query's result (sorted positions `pos`, squared distances `r2`) around a point: the distance
@@ -1302,20 +1331,19 @@ bool EstimateNormals(
   const Index nv = static_cast<Index>(order.size());
   const Index chunk = 65536;
   Index invalid = n - nv;
-  // The wide jets over a thinned cloud when their radius holds far more points than they fit (BuildThinnedCloud;
-  // the fraction from the cloud's scale: the same on every process).
-  NeighborGrid thin;
-  std::vector<double> thinXyz;
+  // The wide jets over thinned clouds when their radius holds far more points than they fit (BuildThinnedClouds;
+  // their number from the cloud's scale: the same on every process).
+  std::vector<NeighborGrid> thin;
   bool thinned = false;
   if (!fixed && options.AdaptToNoise && options.WideNormals && normalRadius > 0.0 && field.Scale.Spacing > 0.0)
   {
     const double expected = Pi * normalRadius * normalRadius / (field.Scale.Spacing * field.Scale.Spacing);
-    if (expected > ThinAbove)
+    const double classes = std::floor(expected / ThinTarget);
+    if (classes >= 2.0)
     {
-      thinned = BuildThinnedCloud(grid, ThinTarget / expected, thin, thinXyz);
+      thinned = BuildThinnedClouds(grid, static_cast<int>(std::min(classes, 64.0)), thin);
     }
   }
-  const double* thinSorted = thin.SortedPoints();
   bool aborted = false;
   // Per sorted position: the jet's misfit and the point's height over it (the sharp features' pass below).
   std::vector<double> rms(static_cast<size_t>(nv), 0.0), height(static_cast<size_t>(nv), 0.0);
@@ -1420,7 +1448,7 @@ bool EstimateNormals(
           const double radius = fixed ? options.SupportRadius : std::max(rk, normalRadius);
           if (d)
           {
-            // Thinned: the cells the jet's query touches must be whole (BuildThinnedCloud).
+            // Thinned: the cells the jet's query touches must be whole (BuildThinnedClouds).
             const double reach = thinned ? radius + std::sqrt(3.0) * grid.CellSize() : radius;
             const double farthest = std::max(std::max(queried, reach), std::max(rk, std::sqrt(nearLimit2)));
             shortfall = std::max(shortfall, Shortfall(d, x, farthest));
@@ -1429,8 +1457,9 @@ bool EstimateNormals(
           const double* fitSorted = sorted;
           if (thinned)
           {
-            thin.FindWithinRadiusPositions(x, radius, pos, r2);
-            fitSorted = thinSorted;
+            const NeighborGrid& mineThin = thin[PositionHash(x) % thin.size()];
+            mineThin.FindWithinRadiusPositions(x, radius, pos, r2);
+            fitSorted = mineThin.SortedPoints();
             if (pos.size() < ThinFloor)
             {
               grid.FindWithinRadiusPositions(x, radius, pos, r2); // sparse here: the whole cloud's

@@ -9,9 +9,11 @@
  * n - a1 t1 - a2 t2; exact on quadrics, where PCA is biased. Over at most 256 of the neighbours, spread over the
  * neighbourhood (the cost stays bounded where the noise asks for thousands). Where the radius holds on average far
  * more points than that (noise large against the spacing: about 1000 at 1M and 10M points of a noisy scan), the
- * jets are fitted over a thinned cloud, the same fraction of every grid cell's points taken at even steps along
- * them (positions only: independent of the order and the split of the cloud), in a grid of its own, so that a
- * query filters only that fraction of the candidates (SurfaceNormals.cxx, BuildThinnedCloud). SurfaceVariation
+ * jets are fitted over one of K = floor(that / 250) thinned clouds that partition every grid cell's points (dealt in
+ * turn along them; positions only: independent of the order and the split of the cloud), each in a grid of its
+ * own, the cloud chosen by a hash of the point's position (neighbours fit different subsets, so the curvature's
+ * smoothing still averages independent noise), so that a query filters 1 / K of the candidates
+ * (SurfaceNormals.cxx, BuildThinnedClouds). SurfaceVariation
  * l0 / (l0 + l1 + l2) of the PCA (Pauly et al. 2002): 0 on a plane, 1/3 for isotropic scatter.
  *
  * Neighbourhood (CloudScale::NormalRadius, one radius R* per cloud, at least r_k at each point). The noise
