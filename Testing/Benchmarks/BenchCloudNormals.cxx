@@ -8,7 +8,7 @@
 // the input (a fixed permutation) and digests the results in the original order: the digest must not change.
 // --wide 0 and --support R: NormalOptions::WideNormals and ::SupportRadius (Meshless Surface's narrow normals, a
 // fixed radius). Stages: the grid and EstimateNormals timed alone, then the whole ComputeCloudNormals (grid, normals,
-// orientation, curvature; --full 0 skips it). Threads: all the CPUs, or MESHFREE_NUM_THREADS.
+// orientation, curvature; --full 0 skips it and times the cloud's scale, EstimateCloudScale, alone instead). Threads: all the CPUs, or MESHFREE_NUM_THREADS.
 // --noise: sigma as a fraction of the diagonal (default 0.001). --accuracy 1: the Curvature's relative error against
 // the exact mean curvature (sphere 1 / rs; torus (R + 2 r cos v) / (2 r (R + r cos v))), mean / p99 / max, separately
 // on the sphere and the torus (points with Curvature 0 or an invalid normal count as error 1).
@@ -274,8 +274,14 @@ int main(int argc, char** argv)
 
     if (!full)
     {
-      std::printf("grid %.3f s, EstimateNormals %.3f s (grid + normals: cpu %.3f s)\n", gridSeconds, normalSeconds,
-        normalCpu);
+      // The cloud's scale alone (EstimateNormals computes it first: its sample's jets, a cost that does not grow
+      // with the cloud).
+      start = std::chrono::steady_clock::now();
+      cpu = CpuSeconds();
+      meshfree::EstimateCloudScale(grid, neighborhood);
+      std::printf("grid %.3f s, EstimateNormals %.3f s (grid + normals: cpu %.3f s), of which the scale ~%.3f s "
+                  "(cpu %.3f s)\n",
+        gridSeconds, normalSeconds, normalCpu, Seconds(start), CpuSeconds() - cpu);
       continue;
     }
     meshfree::CloudNormalsOptions options;

@@ -4,7 +4,7 @@ and p99 in degrees; share consistently oriented; share outward).
 
     pvpython --no-mpi Testing/Benchmarks/bench_scans_normals.py [--points 150000] [--virtual DIR]
         [--levels 0,0.00125,0.006,0.012] [--shapes torus,sphere,cube] [--out DIR] [--work DIR] [--timeout 600]
-        [--no-issue-torus]
+        [--no-issue-torus] [--tools meshfree,pca,cgal]
 
 Clouds: the torus R = 1, r = 0.35, the unit sphere and the cube [-1, 1]^3, --points uniform by area, Gaussian
 noise per axis of sigma = level x the bounding-box diagonal (PCPNet's levels: 0, 0.125 %, 0.6 %, 1.2 %), the true
@@ -16,7 +16,8 @@ Estimators, each in its own process (wall time and peak memory by /usr/bin/time 
   PCA k         k = 18, 112, 450 nearest neighbours, smallest-eigenvector of the covariance (numpy/scipy,
                 scans_pca_normals below); unoriented, so only the angle is compared
   CGAL jet k    peers/cgal_peer normals --method jet, k = 18 and 112; unoriented
-Writes OUT/scans_normals.md and OUT/scans_normals.json.
+--tools: which estimators run (default all three; e.g. --tools meshfree to compare two builds of the plugin, with
+MESHFREE_PLUGIN naming each). Writes OUT/scans_normals.md and OUT/scans_normals.json.
 """
 import argparse
 import datetime
@@ -117,7 +118,9 @@ def main():
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--no-issue-torus", dest="issue_torus", action="store_false",
                     help="leave out issue 23's torus (150k points, sigma 0.002, PCA k 80 beside it)")
+    ap.add_argument("--tools", default="meshfree,pca,cgal", help="comma-separated: meshfree, pca, cgal")
     a = ap.parse_args()
+    tools = set(t for t in a.tools.split(",") if t)
     os.makedirs(a.out, exist_ok=True)
     os.makedirs(a.work, exist_ok=True)
     env = {k: v for k, v in os.environ.items() if not k.startswith("OMP_")}
@@ -165,7 +168,7 @@ def main():
             rows.append(row)
             print(json.dumps(row), flush=True)
 
-        if py:
+        if py and "meshfree" in tools:
             load = loadavg()[0]
             run = run_process([py, "--no-mpi", plugin_runner, "normals", stem + ".vtp", stem + "_mf.vtp"], env,
                               a.timeout)
@@ -176,13 +179,13 @@ def main():
                 mp, mn = read_vtp_normals(stem + "_mf.vtp")
                 ok = len(mp) == len(pts)
             add("MeshFree Meshless Normals", mn if ok else None, run, why=str(info.get("error", ""))[:200])
-        for k in PCA_K + ((80,) if "issue 23" in label else ()):
+        for k in (PCA_K + ((80,) if "issue 23" in label else ())) if "pca" in tools else ():
             import time
             t0, load = time.perf_counter(), loadavg()[0]
             n = pca_normals(pts, min(k, len(pts)))
             add("PCA k %d (SciPy, in-process)" % k, n, dict(wall_s=time.perf_counter() - t0, peak_mb=None,
                                                             load1=load, stderr=""), oriented=False)
-        if os.path.exists(cgal):
+        if "cgal" in tools and os.path.exists(cgal):
             for k in JET_K:
                 load = loadavg()[0]
                 run = run_process([cgal, "normals", stem + ".xyz", stem + "_jet.xyz", "--k", str(k), "--method",

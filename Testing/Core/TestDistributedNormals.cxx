@@ -233,6 +233,18 @@ TEST_F(DistributedNormals, NoisyTorusOnThreeSlabsIsTheSerialRun)
   ExpectSameAsSerial(xyz, CloudNormalsOptions(), 3, 0.6);
 }
 
+TEST_F(DistributedNormals, ThinnedWideJetsOnThreeSlabsAreTheSerialRun)
+{
+  // Noise large against the spacing: the normals' radius holds about 1000 points, so the jets are fitted over the
+  // thinned cloud (SurfaceNormals.cxx, BuildThinnedCloud), a grid of its own on every process.
+  const samples::SurfaceCloud cloud = samples::SampleSurface(false, 20000, 0.02, 17);
+  CloudNormalsResult serial;
+  ASSERT_TRUE(ComputeCloudNormals(cloud.Points.data(), cloud.Count(), nullptr, CloudNormalsOptions(), serial));
+  const double held = M_PI * std::pow(serial.Scale.NormalRadius / serial.Scale.Spacing, 2);
+  ASSERT_GT(held, 400.0) << "the cloud does not exercise the thinned jets";
+  ExpectSameAsSerial(cloud.Points, CloudNormalsOptions(), 3, 1.0);
+}
+
 TEST_F(DistributedNormals, ProjectionAndViewpointOnFourSlabs)
 {
   const samples::SurfaceCloud cloud = samples::SampleSurface(false, 8000, 0.003, 5);

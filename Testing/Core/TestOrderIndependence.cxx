@@ -489,9 +489,10 @@ TEST(OrderIndependence, SurfaceOfAPermutedCloudHasTheSameTriangles)
 TEST(OrderIndependence, NormalsOfAPermutedCloudAreBitwiseEqual)
 {
   // A torus sampled on a (u, v) lattice (every point has pairs of equidistant neighbours: the k-th nearest and
-  // the orientation graph's rows are decided by ties), a noisy random torus (the noise-adapted jets) and a noisy
-  // cube (the sharp-feature pass).
-  std::vector<Cloud> clouds(3);
+  // the orientation graph's rows are decided by ties), a noisy random torus (the noise-adapted jets), a noisy
+  // cube (the sharp-feature pass) and a sphere whose noise is large against its spacing (the normals' radius holds
+  // about 1000 points: the jets over the thinned cloud, chosen by a hash of the positions).
+  std::vector<Cloud> clouds(4);
   for (int i = 0; i < 120; ++i)
   {
     for (int j = 0; j < 40; ++j)
@@ -512,13 +513,24 @@ TEST(OrderIndependence, NormalsOfAPermutedCloudAreBitwiseEqual)
     p[i % 3] = i % 2 ? 1.0 : -1.0;
     clouds[2].insert(clouds[2].end(), { p[0] + 0.005 * g(rng), p[1] + 0.005 * g(rng), p[2] + 0.005 * g(rng) });
   }
-  const char* names[] = { "lattice torus", "noisy torus", "noisy cube" };
-  for (int c = 0; c < 3; ++c)
+  for (int i = 0; i < 20000; ++i)
+  {
+    double p[3] = { g(rng), g(rng), g(rng) };
+    const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    clouds[3].insert(clouds[3].end(), { p[0] / r + 0.02 * g(rng), p[1] / r + 0.02 * g(rng), p[2] / r + 0.02 * g(rng) });
+  }
+  const char* names[] = { "lattice torus", "noisy torus", "noisy cube", "very noisy sphere" };
+  for (int c = 0; c < 4; ++c)
   {
     const Cloud& cloud = clouds[c];
     CloudNormalsResult want;
     ASSERT_TRUE(ComputeCloudNormals(cloud.data(), Count(cloud), nullptr, CloudNormalsOptions(), want));
     EXPECT_EQ(want.Invalid, 0) << names[c];
+    if (c == 3)
+    {
+      ASSERT_GT(M_PI * std::pow(want.Scale.NormalRadius / want.Scale.Spacing, 2), 400.0)
+        << "the cloud does not exercise the thinned jets";
+    }
     for (unsigned seed : { 1u, 2u, 3u })
     {
       const std::vector<Index> perm = Permutation(Count(cloud), seed);

@@ -3,6 +3,7 @@
 #include "Surface/SurfaceNormals.h"
 
 #include "Common/Distribution.h"
+#include "Common/GridCell.h"
 #include "Common/LocalFit.h"
 #include "Common/Parallel.h"
 #include "Common/Statistics.h"
@@ -12,6 +13,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -40,6 +43,12 @@ constexpr double MaxCrossing = 0.2;
 constexpr double NoiseAgreement = 1.5; // the jets' noise at most this many times the PCA spread's (thin parts)
 constexpr double MaxTurn = 0.2; // radians: the most the curvature may turn the normal between a point and its donor
 constexpr Index SamplePoints = 2048; // the scale's sample (CloudSample: by a hash of the positions)
+// The wide jets' thinned clouds (BuildThinnedClouds): floor(n / ThinTarget) of them when the normals' radius holds
+// on average n >= 2 ThinTarget points; a point whose thinned neighbourhood holds fewer than ThinFloor (a sparse
+// region) fits over the whole cloud's.
+constexpr double ThinTarget = 250.0;
+constexpr size_t ThinFloor = MaxFit / 2;
+constexpr size_t MaxThinFit = 320; // a thinned list (evenly spread already) is fitted whole up to this many
 
 struct LocalPCA
 {
@@ -468,15 +477,16 @@ __attribute__((target("avx2"))) void AccumulateJetAvx2(const double* sorted, con
 /// curvature is that of the implicit surface it defines (ImplicitMeanCurvature). The normal stays the plain jet's
 /// (the same bits either way: the second jet's sums are sums of their own).
 template <bool WithCurvature = false>
-JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double x[3], double scale)
+JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double x[3], double scale,
+  size_t limit = MaxFit)
 {
   JetFit out;
   if (count < 3 || !(scale > 0.0))
   {
     return out;
   }
-  const size_t used = std::min(count, MaxFit);
-  Index picked[MaxFit];
+  const size_t used = std::min(count, std::min(limit, MaxThinFit));
+  Index picked[MaxThinFit];
   SpreadSubset(pos, count, used, picked);
   // The frame (PCA) from fewer points still: the jet corrects its tilt.
   const size_t framed = std::min(used, FramePoints);
@@ -593,6 +603,174 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
   }
   out.Valid = n.allFinite();
   return out;
+}
+
+/// The outliers' residual (NormalField::Residual): the distance from x to the degree-2 jet fitted to the points at
+/// sorted positions pos[0..count) (x and its duplicates left out), as FitJet fits it but in the frame of the given
+/// unit normal (the point's wide jet's) instead of the points' own PCA: the jet's constant term is invariant to the
+/// tangent axes' rotation, and a frame a little off tilts the quadric without changing its fit, so the PCA (a
+/// covariance pass and a 3 x 3 eigen-decomposition per point) is saved. Over up to MaxFit of the points spread
+/// over the list; fewer than 12 fitted (or a singular jet): the distance to the plane through their centroid
+/// along the normal. False when there are fewer than 3 points.
+bool JetResidual(const double* sorted, const Index* pos, size_t count, const double x[3], double scale,
+  const double normal[3], double& residual)
+{
+  if (count < 3 || !(scale > 0.0))
+  {
+    return false;
+  }
+  const size_t used = std::min(count, MaxFit);
+  Index picked[MaxFit];
+  SpreadSubset(pos, count, used, picked);
+  const double inv = 1.0 / scale;
+  // Tangent axes: any orthonormal pair completing the normal.
+  const double e3[3] = { normal[0], normal[1], normal[2] };
+  const int smallest = std::fabs(e3[0]) <= std::fabs(e3[1]) ? (std::fabs(e3[0]) <= std::fabs(e3[2]) ? 0 : 2)
+                                                            : (std::fabs(e3[1]) <= std::fabs(e3[2]) ? 1 : 2);
+  double axis[3] = { 0.0, 0.0, 0.0 };
+  axis[smallest] = 1.0;
+  double e1[3] = { axis[1] * e3[2] - axis[2] * e3[1], axis[2] * e3[0] - axis[0] * e3[2],
+    axis[0] * e3[1] - axis[1] * e3[0] };
+  const double length = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  if (!(length > 0.0))
+  {
+    return false;
+  }
+  for (double& c : e1)
+  {
+    c /= length;
+  }
+  const double e2[3] = { e3[1] * e1[2] - e3[2] * e1[1], e3[2] * e1[0] - e3[0] * e1[2],
+    e3[0] * e1[1] - e3[1] * e1[0] };
+  JetSums sums;
+#ifdef MESHFREE_NORMALS_AVX2
+  if (VectorKernels.load(std::memory_order_relaxed))
+  {
+    AccumulateJetAvx2<false>(sorted, picked, used, x, inv, e1, e2, e3, sums);
+  }
+  else
+#endif
+  {
+    AccumulateJet<false>(sorted, picked, used, x, inv, e1, e2, e3, sums);
+  }
+  if (sums.Fitted >= 12)
+  {
+    static constexpr int Product[6][6] = { { 0, 1, 2, 3, 4, 5 }, { 1, 3, 4, 6, 7, 8 }, { 2, 4, 5, 7, 8, 9 },
+      { 3, 6, 7, 10, 11, 12 }, { 4, 7, 8, 11, 12, 13 }, { 5, 8, 9, 12, 13, 14 } };
+    Eigen::Matrix<double, 6, 6> M;
+    Eigen::Matrix<double, 6, 1> B, a;
+    for (int i = 0; i < 6; ++i)
+    {
+      B(i) = sums.H[i];
+      for (int j = 0; j < 6; ++j)
+      {
+        M(i, j) = sums.U[Product[i][j]];
+      }
+    }
+    double condition = 0.0;
+    if (SolveMoment<6>(M, B, a, false, condition) && a.allFinite())
+    {
+      residual = std::fabs(a(0)) * scale;
+      return true;
+    }
+  }
+  if (sums.Fitted == 0)
+  {
+    return false;
+  }
+  // The plane through the centroid of the fitted points (U[1], U[2]: sums of u, v; H[0]: of h), along the normal.
+  residual = std::fabs(sums.H[0] / static_cast<double>(sums.Fitted)) * scale;
+  return std::isfinite(residual);
+}
+
+/// A hash of a position's coordinates (+0 and -0 alike): which thinned cloud a point's jet uses.
+std::uint64_t PositionHash(const double x[3])
+{
+  std::uint64_t h = 0x243f6a8885a308d3ull;
+  for (int a = 0; a < 3; ++a)
+  {
+    const double v = x[a] == 0.0 ? 0.0 : x[a];
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    h = (h ^ bits) * 0x9e3779b97f4a7c15ull;
+    h ^= h >> 29;
+    h *= 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 32;
+  }
+  return h;
+}
+
+/// The wide jets' thinned clouds: where the normals' radius holds far more points than a jet fits (MaxFit; at 1M
+/// and 10M points of a noisy scan about 1000), each jet is fitted over one of `classes` thinned clouds, so that a
+/// query filters that fraction of the candidates. The classes partition every cell of `grid`: its points (sorted
+/// by position) in turn, from a phase set by the cell's coordinates, as the jets' own subset (SpreadSubset) steps
+/// along a list in cell order (a random fraction, by a hash of the positions, was measured less accurate: the count
+/// per cell then varies). A point's jet uses the class its position hashes to, so that neighbouring points fit
+/// different subsets: their curvatures' noise stays independent and the smoothing takes it out (one shared thinned
+/// cloud made the smoothed curvature's error 10-45 % larger). The selection depends on the cell's points alone:
+/// the same whatever the order and the split of the cloud when the cell is whole (a distributed query's reach grows
+/// by a cell's diagonal). Each class' grid is laid out from the whole cloud's frame (the same cells on every
+/// process), its cells sqrt(classes) times as wide (as many points per cell on a surface). False when a class is
+/// empty.
+bool BuildThinnedClouds(const NeighborGrid& grid, int classes, std::vector<NeighborGrid>& thin)
+{
+  const Index nv = grid.NumberOfValidPoints();
+  const double* sorted = grid.SortedPoints();
+  double bounds[6];
+  Index framePoints = 0, dims[3];
+  grid.GetFrame(bounds, framePoints);
+  grid.GetGridDimensions(dims);
+  const double inverse = 1.0 / grid.CellSize();
+  auto cellOf = [&](Index s, Index cell[3]) {
+    for (int a = 0; a < 3; ++a)
+    {
+      cell[a] = GridAxisCell(sorted[3 * s + a] - bounds[2 * a], inverse, dims[a]);
+    }
+  };
+  std::vector<std::vector<double>> xyz(static_cast<size_t>(classes));
+  for (std::vector<double>& c : xyz)
+  {
+    c.reserve(static_cast<size_t>(3 * (nv / classes + 1)));
+  }
+  Index begin = 0, first[3] = { 0, 0, 0 };
+  if (nv > 0)
+  {
+    cellOf(0, first);
+  }
+  for (Index s = 0; s < nv; ++s)
+  {
+    Index next[3] = { -1, -1, -1 };
+    if (s + 1 < nv)
+    {
+      cellOf(s + 1, next);
+    }
+    if (next[0] == first[0] && next[1] == first[1] && next[2] == first[2])
+    {
+      continue; // s is not the last point of its cell
+    }
+    // The cell [begin, s]: its points dealt to the classes in turn.
+    const Index phase = (first[0] + 3 * first[1] + 7 * first[2]) % classes;
+    for (Index j = begin; j <= s; ++j)
+    {
+      std::vector<double>& c = xyz[static_cast<size_t>((j - begin + phase) % classes)];
+      c.insert(c.end(), sorted + 3 * j, sorted + 3 * j + 3);
+    }
+    begin = s + 1;
+    std::copy(next, next + 3, first);
+  }
+  thin.assign(static_cast<size_t>(classes), NeighborGrid());
+  for (int c = 0; c < classes; ++c)
+  {
+    thin[c].SetFrame(bounds, std::max<Index>(1, framePoints / classes));
+    if (!thin[c].Build(xyz[c].data(), static_cast<Index>(xyz[c].size() / 3),
+          grid.CellSize() * std::sqrt(static_cast<double>(classes))))
+    {
+      thin.clear();
+      return false;
+    }
+    std::vector<double>().swap(xyz[c]);
+  }
+  return true;
 }
 
 /// From a radius query's result (sorted positions `pos`, squared distances `r2`) around a point: the distance
@@ -1153,6 +1331,19 @@ bool EstimateNormals(
   const Index nv = static_cast<Index>(order.size());
   const Index chunk = 65536;
   Index invalid = n - nv;
+  // The wide jets over thinned clouds when their radius holds far more points than they fit (BuildThinnedClouds;
+  // their number from the cloud's scale: the same on every process).
+  std::vector<NeighborGrid> thin;
+  bool thinned = false;
+  if (!fixed && options.AdaptToNoise && options.WideNormals && normalRadius > 0.0 && field.Scale.Spacing > 0.0)
+  {
+    const double expected = Pi * normalRadius * normalRadius / (field.Scale.Spacing * field.Scale.Spacing);
+    const double classes = std::floor(expected / ThinTarget);
+    if (classes >= 2.0)
+    {
+      thinned = BuildThinnedClouds(grid, static_cast<int>(std::min(classes, 64.0)), thin);
+    }
+  }
   bool aborted = false;
   // Per sorted position: the jet's misfit and the point's height over it (the sharp features' pass below).
   std::vector<double> rms(static_cast<size_t>(nv), 0.0), height(static_cast<size_t>(nv), 0.0);
@@ -1208,17 +1399,18 @@ bool EstimateNormals(
           std::int32_t* row = &field.Graph[static_cast<size_t>(id) * degree];
           // One radius query, wide enough for every radius the point may need, usually holds its k nearest too:
           // it gives r_k, the orientation graph and the neighbourhood. Otherwise a k-nearest query first.
-          if (first > 0.0)
+          // Thinned: the wide list comes from the thinned cloud below, this query gives only the near part.
+          if (first > 0.0 && !thinned)
           {
             grid.FindWithinRadiusPositions(x, first, pos, r2);
           }
-          double queried = first;
+          double queried = thinned ? 0.0 : first;
           // The near part of the list, once (a copy: the list may be cut or queried again below): the k nearest
           // and the outliers' small neighbourhood lie in it. When it is narrower than the list, from a query of its
           // own (a few cells: a pass over the wide list cost more, also fused into the wide query's filter), a little
           // wider since its radius squared may round below nearLimit2, then cut exactly: the list's points within
           // sqrt(nearLimit2), in its order.
-          if (!(first > 0.0 && nearLimit2 < first * first))
+          if (!thinned && !(first > 0.0 && nearLimit2 < first * first))
           {
             mine.Small.assign(pos.begin(), pos.end());
             mine.SmallD2.assign(r2.begin(), r2.end());
@@ -1256,10 +1448,25 @@ bool EstimateNormals(
           const double radius = fixed ? options.SupportRadius : std::max(rk, normalRadius);
           if (d)
           {
-            const double farthest = std::max(std::max(queried, radius), std::max(rk, std::sqrt(nearLimit2)));
+            // Thinned: the cells the jet's query touches must be whole (BuildThinnedClouds).
+            const double reach = thinned ? radius + std::sqrt(3.0) * grid.CellSize() : radius;
+            const double farthest = std::max(std::max(queried, reach), std::max(rk, std::sqrt(nearLimit2)));
             shortfall = std::max(shortfall, Shortfall(d, x, farthest));
           }
-          if (queried < radius)
+          // The coordinates the jet's list refers to (the thinned cloud's when it comes from there).
+          const double* fitSorted = sorted;
+          if (thinned)
+          {
+            const NeighborGrid& mineThin = thin[PositionHash(x) % thin.size()];
+            mineThin.FindWithinRadiusPositions(x, radius, pos, r2);
+            fitSorted = mineThin.SortedPoints();
+            if (pos.size() < ThinFloor)
+            {
+              grid.FindWithinRadiusPositions(x, radius, pos, r2); // sparse here: the whole cloud's
+              fitSorted = sorted;
+            }
+          }
+          else if (queried < radius)
           {
             grid.FindWithinRadiusPositions(x, radius, pos, r2);
           }
@@ -1279,8 +1486,10 @@ bool EstimateNormals(
             pos.resize(kept);
             r2.resize(kept);
           }
-          const JetFit fit = options.MeanCurvature ? FitJet<true>(sorted, pos.data(), pos.size(), x, radius)
-                                                   : FitJet(sorted, pos.data(), pos.size(), x, radius);
+          const size_t limit = fitSorted == sorted ? MaxFit : MaxThinFit;
+          const JetFit fit = options.MeanCurvature
+            ? FitJet<true>(fitSorted, pos.data(), pos.size(), x, radius, limit)
+            : FitJet(fitSorted, pos.data(), pos.size(), x, radius, limit);
           if (!fit.Valid)
           {
             ++failed;
@@ -1301,7 +1510,13 @@ bool EstimateNormals(
           if (small < radius)
           {
             const double cut = small * small;
-            const bool inNear = queried > 0.0 && cut <= nearLimit2;
+            // The near list holds them (it is the whole cloud's whenever a query made it); else the jet's list
+            // when it is the whole cloud's, or a query of their own (the jet's is the thinned cloud's).
+            const bool inNear = (queried > 0.0 || thinned) && first > 0.0 && cut <= nearLimit2;
+            if (!inNear && fitSorted != sorted)
+            {
+              grid.FindWithinRadiusPositions(x, small, pos, r2);
+            }
             const Index* from = inNear ? nearPos : pos.data();
             const double* fromD2 = inNear ? nearD2 : r2.data();
             const size_t fromCount = inNear ? mine.Small.size() : pos.size();
@@ -1315,8 +1530,9 @@ bool EstimateNormals(
               mine.Local[local] = from[j];
               local += fromD2[j] <= cut ? 1 : 0;
             }
-            const JetFit localFit = FitJet(sorted, mine.Local.data(), local, x, small);
-            field.Residual[id] = localFit.Valid ? localFit.Residual : fit.Residual;
+            double residual = 0.0;
+            field.Residual[id] =
+              JetResidual(sorted, mine.Local.data(), local, x, small, fit.Normal, residual) ? residual : fit.Residual;
           }
           const double total = fit.Eigenvalues[0] + fit.Eigenvalues[1] + fit.Eigenvalues[2];
           field.SurfaceVariation[id] = total > 0.0 ? fit.Eigenvalues[0] / total : 0.0;

@@ -7,7 +7,13 @@
  * Normal: the jet of Cazals & Pouget (2005): the neighbours' heights over their PCA plane (coordinates shifted
  * to the point and scaled by the radius) fitted by h = a0 + a1 u + a2 v + a3 u^2 + a4 uv + a5 v^2, the normal
  * n - a1 t1 - a2 t2; exact on quadrics, where PCA is biased. Over at most 256 of the neighbours, spread over the
- * neighbourhood (the cost stays bounded where the noise asks for thousands). SurfaceVariation
+ * neighbourhood (the cost stays bounded where the noise asks for thousands). Where the radius holds on average far
+ * more points than that (noise large against the spacing: about 1000 at 1M and 10M points of a noisy scan), the
+ * jets are fitted over one of K = floor(that / 250) thinned clouds that partition every grid cell's points (dealt in
+ * turn along them; positions only: independent of the order and the split of the cloud), each in a grid of its
+ * own, the cloud chosen by a hash of the point's position (neighbours fit different subsets, so the curvature's
+ * smoothing still averages independent noise), so that a query filters 1 / K of the candidates
+ * (SurfaceNormals.cxx, BuildThinnedClouds). SurfaceVariation
  * l0 / (l0 + l1 + l2) of the PCA (Pauly et al. 2002): 0 on a plane, 1/3 for isotropic scatter.
  *
  * Neighbourhood (CloudScale::NormalRadius, one radius R* per cloud, at least r_k at each point). The noise
@@ -52,7 +58,7 @@
  *
  * Outliers: a point whose r_k is over 3 x the mean r_k of its nearest neighbours (alone in its surroundings;
  * a sparse region of a scan has sparse neighbours too), or farther from the quadric fitted to its neighbourhood
- * than 6 x the median of that distance
+ * (at max(r_k, CloudScale::Radius), in the frame of the point's own jet's normal) than 6 x the median of that distance
  * (about 4 sigma for Gaussian noise; with a floor of 5 % of the radius for exact data) keeps its normal but is
  * flagged, and the implicit fits leave it out (FitSupports gives it no support).
  */
