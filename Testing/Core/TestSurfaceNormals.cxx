@@ -186,6 +186,24 @@ TEST(SurfaceNormals, ExactCloudsAreOrientedOutwardEverywhere)
   }
 }
 
+TEST(SurfaceNormals, CubesAreOrientedOutwardAcrossTheirSharpEdges)
+{
+  // Sharp normals meet at 90 degrees across a cube's edges: a block of the propagation that straddled an edge turned
+  // one side by the sign of a single near-perpendicular pair, in patches along the edges. Measured here: 0.946 and
+  // 0.979 outward before the fix, 0.9986 and 1.0000 with it.
+  for (const double level : { 0.0, 0.00125 })
+  {
+    const samples::SurfaceCloud cloud = SampleCube(150000, level * 2.0 * std::sqrt(3.0), 3);
+    CloudNormalsOptions options;
+    options.ComputeCurvature = false;
+    CloudNormalsResult r;
+    ASSERT_TRUE(ComputeCloudNormals(cloud.Points.data(), cloud.Count(), nullptr, options, r));
+    const NormalScore s = Score(cloud, cloud.Points, r.Normals);
+    std::printf("cube, noise %g: outward %.4f\n", level, s.Outward);
+    EXPECT_GT(s.Outward, 0.995) << "noise " << level;
+  }
+}
+
 TEST(SurfaceNormals, NeighbourhoodFollowsTheNoise)
 {
   // At 200k points the spacing (0.0079) is below sigma = 0.01: a fixed k = 20 neighbourhood would tilt the

@@ -16,6 +16,12 @@ namespace meshfree
 
 namespace
 {
+/// The largest cost 1 - |cos| of an edge followed inside a block (60 degrees).
+constexpr float kBlockEdgeCost = 0.5f;
+} // namespace
+
+namespace
+{
 /// Monotone-enough priority queue for Prim's propagation: costs 1 - |cos| in [0, 1] fall into buckets
 /// uniform in sqrt(cost) (about the angle: 1024 buckets, 0.08 degrees each near 0), popped lowest first.
 /// Lowering a key pushes the point again; the caller skips points already taken (lazy deletion). Against a
@@ -471,7 +477,9 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   std::vector<std::int32_t>().swap(linked);
 
   // Prim's propagation inside each block (blocks in parallel): components numbered in the block from its first
-  // point in sorted order.
+  // point in sorted order. Only edges whose normals agree up to sign within 60 degrees are followed: a block
+  // across a sharp crease (a cube's edge) would otherwise turn one side by the sign of a single near-90-degree
+  // pair; the crease's sides become separate nodes, joined by the nodes' summed votes, strongest first.
   std::vector<double> sortedConfidence(static_cast<size_t>(nv), 0.0);
   std::vector<unsigned char> done(static_cast<size_t>(nv), 0);
   std::vector<std::int32_t> parent(static_cast<size_t>(nv), -1);
@@ -526,7 +534,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
               continue;
             }
             const float cost = static_cast<float>(1.0 - std::fabs(Dot(nu, &normals[3 * v])));
-            if (cost < key[v])
+            if (cost < key[v] && cost <= kBlockEdgeCost)
             {
               key[v] = cost;
               parent[v] = u;
