@@ -462,6 +462,22 @@ __attribute__((target("avx2"))) void AccumulateJetAvx2(const double* sorted, con
 }
 #endif
 
+/// The jet's moment sums with the kernels chosen at run time (AVX2 where the CPU has it and they are enabled:
+/// SetNormalKernelsVectorized), the same bits either way.
+template <bool WithCurvature>
+void AccumulateJetSums(const double* sorted, const Index* picked, size_t used, const double x[3], double inv,
+  const double e1[3], const double e2[3], const double e3[3], JetSums& out)
+{
+#ifdef MESHFREE_NORMALS_AVX2
+  if (VectorKernels.load(std::memory_order_relaxed))
+  {
+    AccumulateJetAvx2<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, out);
+    return;
+  }
+#endif
+  AccumulateJet<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, out);
+}
+
 /// A degree-2 jet (Cazals & Pouget 2005) over up to MaxFit of the points at sorted positions pos[0..count)
 /// (a subset spread evenly over the list when there are more: the list is in cell order, so the subset is
 /// spread over the neighbourhood and depends only on the positions), in coordinates shifted to x and scaled
@@ -509,16 +525,7 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
     // Moments of the basis b = (1, u, v, u^2, uv, v^2): sums of u^i v^j up to i + j = 4, and of h b.
     const double e1[3] = { t1(0), t1(1), t1(2) }, e2[3] = { t2(0), t2(1), t2(2) }, e3[3] = { n(0), n(1), n(2) };
     JetSums sums;
-#ifdef MESHFREE_NORMALS_AVX2
-    if (VectorKernels.load(std::memory_order_relaxed))
-    {
-      AccumulateJetAvx2<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, sums);
-    }
-    else
-#endif
-    {
-      AccumulateJet<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, sums);
-    }
+    AccumulateJetSums<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, sums);
     const double* su = sums.U; // 1 u v uu uv vv uuu uuv uvv vvv uuuu uuuv uuvv uvvv vvvv
     const double* sh = sums.H;
     const double hh = sums.HH;
@@ -643,16 +650,7 @@ bool JetResidual(const double* sorted, const Index* pos, size_t count, const dou
   const double e2[3] = { e3[1] * e1[2] - e3[2] * e1[1], e3[2] * e1[0] - e3[0] * e1[2],
     e3[0] * e1[1] - e3[1] * e1[0] };
   JetSums sums;
-#ifdef MESHFREE_NORMALS_AVX2
-  if (VectorKernels.load(std::memory_order_relaxed))
-  {
-    AccumulateJetAvx2<false>(sorted, picked, used, x, inv, e1, e2, e3, sums);
-  }
-  else
-#endif
-  {
-    AccumulateJet<false>(sorted, picked, used, x, inv, e1, e2, e3, sums);
-  }
+  AccumulateJetSums<false>(sorted, picked, used, x, inv, e1, e2, e3, sums);
   if (sums.Fitted >= 12)
   {
     static constexpr int Product[6][6] = { { 0, 1, 2, 3, 4, 5 }, { 1, 3, 4, 6, 7, 8 }, { 2, 4, 5, 7, 8, 9 },
