@@ -2,6 +2,7 @@
 on clouds whose true normals are known, scored by scans_score.score_normals (angle to the true normal line: mean
 and p99 in degrees; share consistently oriented; share outward).
 
+    LD_PRELOAD=build/lib/libmeshfree_expat_compat.so \
     pvpython --no-mpi Testing/Benchmarks/bench_scans_normals.py [--points 150000] [--virtual DIR]
         [--levels 0,0.00125,0.006,0.012] [--shapes torus,sphere,cube] [--out DIR] [--work DIR] [--timeout 600]
         [--no-issue-torus] [--tools meshfree,pca,cgal]
@@ -17,7 +18,9 @@ Estimators, each in its own process (wall time and peak memory by /usr/bin/time 
                 scans_pca_normals below); unoriented, so only the angle is compared
   CGAL jet k    peers/cgal_peer normals --method jet, k = 18 and 112; unoriented
 --tools: which estimators run (default all three; e.g. --tools meshfree to compare two builds of the plugin, with
-MESHFREE_PLUGIN naming each). Writes OUT/scans_normals.md and OUT/scans_normals.json.
+MESHFREE_PLUGIN naming each). Writes OUT/scans_normals.md and OUT/scans_normals.json. The preload is the build's
+expat shim (README, "Debian 12's expat and ParaView 5.11"): without it the .vtp files of the MeshFree runs cannot be
+read back and every MeshFree row fails.
 """
 import argparse
 import datetime
