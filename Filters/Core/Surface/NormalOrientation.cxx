@@ -18,10 +18,7 @@ namespace
 {
 /// The largest cost 1 - |cos| of an edge followed inside a block (60 degrees).
 constexpr float kBlockEdgeCost = 0.5f;
-} // namespace
 
-namespace
-{
 /// Monotone-enough priority queue for Prim's propagation: costs 1 - |cos| in [0, 1] fall into buckets
 /// uniform in sqrt(cost) (about the angle: 1024 buckets, 0.08 degrees each near 0), popped lowest first.
 /// Lowering a key pushes the point again; the caller skips points already taken (lazy deletion). Against a

@@ -478,6 +478,22 @@ void AccumulateJetSums(const double* sorted, const Index* picked, size_t used, c
   AccumulateJet<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, out);
 }
 
+/// The jet's normal equations from its moment sums: M(i, j) = sum b_i b_j (the monomial of b_i times b_j, from
+/// sums.U: 1 u v uu uv vv uuu uuv uvv vvv uuuu uuuv uuvv uvvv vvvv) and B(i) = sum h b_i, b = (1, u, v, u^2, uv, v^2).
+void JetSystem(const JetSums& sums, Eigen::Matrix<double, 6, 6>& M, Eigen::Matrix<double, 6, 1>& B)
+{
+  static constexpr int Product[6][6] = { { 0, 1, 2, 3, 4, 5 }, { 1, 3, 4, 6, 7, 8 }, { 2, 4, 5, 7, 8, 9 },
+    { 3, 6, 7, 10, 11, 12 }, { 4, 7, 8, 11, 12, 13 }, { 5, 8, 9, 12, 13, 14 } };
+  for (int i = 0; i < 6; ++i)
+  {
+    B(i) = sums.H[i];
+    for (int j = 0; j < 6; ++j)
+    {
+      M(i, j) = sums.U[Product[i][j]];
+    }
+  }
+}
+
 /// A degree-2 jet (Cazals & Pouget 2005) over up to MaxFit of the points at sorted positions pos[0..count)
 /// (a subset spread evenly over the list when there are more: the list is in cell order, so the subset is
 /// spread over the neighbourhood and depends only on the positions), in coordinates shifted to x and scaled
@@ -526,23 +542,11 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
     const double e1[3] = { t1(0), t1(1), t1(2) }, e2[3] = { t2(0), t2(1), t2(2) }, e3[3] = { n(0), n(1), n(2) };
     JetSums sums;
     AccumulateJetSums<WithCurvature>(sorted, picked, used, x, inv, e1, e2, e3, sums);
-    const double* su = sums.U; // 1 u v uu uv vv uuu uuv uvv vvv uuuu uuuv uuvv uvvv vvvv
-    const double* sh = sums.H;
     const double hh = sums.HH;
     const size_t fitted = sums.Fitted;
-    // M(i, j) = sum b_i b_j: the monomial of b_i times b_j.
-    static constexpr int Product[6][6] = { { 0, 1, 2, 3, 4, 5 }, { 1, 3, 4, 6, 7, 8 }, { 2, 4, 5, 7, 8, 9 },
-      { 3, 6, 7, 10, 11, 12 }, { 4, 7, 8, 11, 12, 13 }, { 5, 8, 9, 12, 13, 14 } };
     Eigen::Matrix<double, 6, 6> M;
     Eigen::Matrix<double, 6, 1> B;
-    for (int i = 0; i < 6; ++i)
-    {
-      B(i) = sh[i];
-      for (int j = 0; j < 6; ++j)
-      {
-        M(i, j) = su[Product[i][j]];
-      }
-    }
+    JetSystem(sums, M, B);
     const Eigen::Matrix<double, 6, 6> moments = M;
     Eigen::Matrix<double, 6, 1> a;
     double condition = 0.0;
@@ -653,18 +657,9 @@ bool JetResidual(const double* sorted, const Index* pos, size_t count, const dou
   AccumulateJetSums<false>(sorted, picked, used, x, inv, e1, e2, e3, sums);
   if (sums.Fitted >= 12)
   {
-    static constexpr int Product[6][6] = { { 0, 1, 2, 3, 4, 5 }, { 1, 3, 4, 6, 7, 8 }, { 2, 4, 5, 7, 8, 9 },
-      { 3, 6, 7, 10, 11, 12 }, { 4, 7, 8, 11, 12, 13 }, { 5, 8, 9, 12, 13, 14 } };
     Eigen::Matrix<double, 6, 6> M;
     Eigen::Matrix<double, 6, 1> B, a;
-    for (int i = 0; i < 6; ++i)
-    {
-      B(i) = sums.H[i];
-      for (int j = 0; j < 6; ++j)
-      {
-        M(i, j) = sums.U[Product[i][j]];
-      }
-    }
+    JetSystem(sums, M, B);
     double condition = 0.0;
     if (SolveMoment<6>(M, B, a, false, condition) && a.allFinite())
     {
