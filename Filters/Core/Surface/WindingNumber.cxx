@@ -272,7 +272,7 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
   }
   std::vector<std::pair<std::uint64_t, size_t>>().swap(gathered);
   // The top tree's shapes first (centre, radius, area: its splits and which nodes this process needs), then its
-  // nodes: distributed, a node no evaluation of this process can open keeps only its moments (TopNeeded).
+  // nodes: distributed, a node no evaluation of this process can open keeps only its moments (EmitTop).
   std::vector<TopShape> shapes(nc - 1);
   this->ShapeTop(leaves, 0, nc, 0, shapes);
   this->Root = this->EmitTop(leaves, 0, nc, 0, shapes, d && lattice ? d : nullptr);
@@ -281,7 +281,8 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
 
 namespace
 {
-/// A node's centre (area-weighted), area and radius bound from its two children's, as WindingNumber::Combine.
+/// A node's centre (area-weighted), area and radius bound from its two children's (WindingNumber::Combine adds the
+/// moments).
 template <typename Child, typename Parent>
 void CombineShape(const Child& left, const Child& right, Parent& node)
 {
@@ -424,26 +425,11 @@ Index WindingNumber::EmitTop(const std::vector<TopLeaf>& leaves, size_t begin, s
 
 void WindingNumber::Combine(Node& node, const Node& left, const Node& right) const
 {
+  CombineShape(left, right, node);
   std::fill(node.Moment, node.Moment + 3, 0.0);
   std::fill(node.Second, node.Second + 9, 0.0);
   std::fill(node.Third, node.Third + 27, 0.0);
-  double area = 0.0, c[3] = { 0, 0, 0 };
-  const Node* children[2] = { &left, &right };
-  for (const Node* child : children)
-  {
-    area += child->Area;
-    for (int a = 0; a < 3; ++a)
-    {
-      c[a] += child->Area * child->Centre[a];
-    }
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    node.Centre[a] = c[a] / area;
-  }
-  node.Area = area;
-  node.Radius = 0.0;
-  for (const Node* child : children)
+  for (const Node* child : { &left, &right })
   {
     // With d = d_child + e, e = c_child - c: Q = Q_child + e M^T, and
     // C_abl = C_child,abl + Q_child,ba e_l + e_b Q_child,la + e_b e_l M_a.
@@ -464,7 +450,6 @@ void WindingNumber::Combine(Node& node, const Node& left, const Node& right) con
         }
       }
     }
-    node.Radius = std::max(node.Radius, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + child->Radius);
   }
 }
 
