@@ -807,8 +807,10 @@ int vtkMeshlessSurface::ReconstructDistributed(
   fd->AddArray(local);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", radius);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloAttempts", attempts);
-  // The halo width the last attempt needed: its radius less the slack every computation left (or plus its shortfall).
-  vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloNeeded", std::isfinite(shortfall) ? radius + shortfall : 0.0);
+  // The halo width the last attempt needed: its radius less the slack every computation left (or plus its shortfall);
+  // 0 when not known (no computation measured it, or the halo was the whole cloud).
+  const double needed = radius + shortfall;
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloNeeded", std::isfinite(needed) ? needed : 0.0);
   return 1;
 }
 
