@@ -476,6 +476,13 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     }
     support = FitSupports(
       normals, options.SupportScale, options.NoiseScale, options.SupportRadius > 0.0, report.SupportRadius, d);
+    // What the fits, the hole filling, the contour and the trimming no longer read goes now: the orientation's
+    // graph, the radii and the normals' statistics (56 bytes per point; a distributed run's peak falls in the
+    // contour, the serial one's in the orientation: issue 24).
+    std::vector<std::int32_t>().swap(normals.Graph);
+    std::vector<double>().swap(normals.Radii);
+    std::vector<double>().swap(normals.SurfaceVariation);
+    std::vector<double>().swap(normals.Residual);
     if (!(cell > 0.0))
     {
       // 1.5 sample spacings (about 0.7 vertices per sample), or a quarter of the fits' support (finer detail
@@ -519,6 +526,13 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
       field = std::move(filled);
     }
     report.FillSeconds = seconds(fillStart);
+    if (!report.HolesFilled || d)
+    {
+      // The fits keep their own copy of the normals (PointSetSurface) or none (PatchSurface), and the winding
+      // number's tree its own, built by now when distributed (serially on first use, when it still reads these).
+      std::vector<double>().swap(normals.Normals);
+      std::vector<double>().swap(areas);
+    }
     std::vector<unsigned char> seeding(normals.Valid);
     for (size_t i = 0; i < seeding.size(); ++i)
     {

@@ -14,6 +14,12 @@ namespace
 {
 constexpr double kInverseFourPi = 0.25 / M_PI;
 constexpr Index kLeafSize = 32; // a node holds 44 doubles: bigger leaves keep the tree at about 1.5 doubles per point
+
+/// The number of nodes BuildNode makes over `size` points (halves until a node holds at most kLeafSize).
+size_t TreeNodes(Index size)
+{
+  return size <= kLeafSize ? 1 : 1 + TreeNodes(size / 2) + TreeNodes(size - size / 2);
+}
 } // namespace
 
 void WindingNumber::Build(const double* points, const double* normals, const double* areas, Index count, double beta)
@@ -57,10 +63,10 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
 {
   const Distribution* d = cubes.Processes;
   this->Nodes.clear();
+  this->Top.clear();
   this->Points.clear();
   this->Normals.clear();
   this->Areas.clear();
-  this->Soft2.clear();
   this->Total = 0.0;
   this->Root = 0;
   this->BuildShortfall = -HUGE_VAL;
@@ -75,6 +81,7 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     Item It;
   };
   std::vector<Keyed> keyed;
+  keyed.reserve(static_cast<size_t>(std::max<Index>(count, 0)));
   for (Index i = 0; i < count; ++i)
   {
     const double* p = points + 3 * i;
@@ -92,10 +99,15 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
         (std::lexicographical_compare(a.It.P, a.It.P + 3, b.It.P, b.It.P + 3) ||
           (std::equal(a.It.P, a.It.P + 3, b.It.P) && a.It.Id < b.It.Id)));
   });
-  // The cubes this process holds completely (all of them when serial): their points, in cube order.
+  // The cubes this process holds completely (all of them when serial): their points, in cube order. The groups are
+  // found first so that the points and the trees' nodes are allocated once at their exact size (a rank's peak
+  // memory falls in this build: issue 24).
   std::vector<Item> items;
   std::vector<std::pair<std::uint64_t, std::pair<Index, Index>>> held; // key, [begin, end) in items
+  std::vector<size_t> heldStart;                                        // where each held cube starts in keyed
   std::vector<std::uint64_t> seen;                                      // every cube with a local point
+  Index heldPoints = 0;
+  size_t cubeNodes = 0;
   for (size_t g = 0; g < keyed.size();)
   {
     size_t h = g;
@@ -119,42 +131,56 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     }
     if (complete)
     {
-      const Index begin = static_cast<Index>(items.size());
-      for (size_t k = g; k < h; ++k)
-      {
-        items.push_back(keyed[k].It);
-      }
-      held.emplace_back(key, std::make_pair(begin, static_cast<Index>(items.size())));
+      const Index size = static_cast<Index>(h - g);
+      held.emplace_back(key, std::make_pair(heldPoints, heldPoints + size));
+      heldStart.push_back(g);
+      heldPoints += size;
+      cubeNodes += TreeNodes(size);
     }
     g = h;
   }
+  items.reserve(static_cast<size_t>(heldPoints));
+  for (size_t c = 0; c < held.size(); ++c)
+  {
+    const size_t g = heldStart[c];
+    for (Index k = 0; k < held[c].second.second - held[c].second.first; ++k)
+    {
+      items.push_back(keyed[g + static_cast<size_t>(k)].It);
+    }
+  }
+  std::vector<size_t>().swap(heldStart);
   std::vector<Keyed>().swap(keyed);
-  this->Nodes.reserve(static_cast<size_t>(4 * (items.size() / kLeafSize + held.size() + 1)));
+  this->Nodes.reserve(cubeNodes);
   std::vector<Index> heldRoot(held.size());
   for (size_t c = 0; c < held.size(); ++c)
   {
     heldRoot[c] = this->BuildNode(held[c].second.first, held[c].second.second, items);
   }
-  // Copy the points in tree order (leaves read them contiguously).
+  // Copy the points in tree order (leaves read them contiguously): the positions and ids first, so that the items
+  // go before the normals and areas are allocated.
   const size_t m = items.size();
   this->Points.resize(3 * m);
-  this->Normals.resize(3 * m);
-  this->Areas.resize(m);
-  this->Soft2.resize(m);
+  std::vector<Index> ids(m);
   for (size_t s = 0; s < m; ++s)
   {
-    const Index i = items[s].Id;
+    std::copy(items[s].P, items[s].P + 3, &this->Points[3 * s]);
+    ids[s] = items[s].Id;
+  }
+  std::vector<Item>().swap(items);
+  this->Normals.resize(3 * m);
+  this->Areas.resize(m);
+  for (size_t s = 0; s < m; ++s)
+  {
+    const Index i = ids[s];
     const double* n = normals + 3 * i;
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     for (int a = 0; a < 3; ++a)
     {
-      this->Points[3 * s + a] = points[3 * i + a];
       this->Normals[3 * s + a] = n[a] / len;
     }
     this->Areas[s] = areas[i];
-    this->Soft2[s] = areas[i] / M_PI;
   }
-  std::vector<Item>().swap(items);
+  std::vector<Index>().swap(ids);
   // Moments bottom-up (within a cube's tree children always follow their parent in this->Nodes): leaves sum their
   // points, inner nodes combine their children's moments moved to their own centre (O(n) in all).
   for (size_t k = this->Nodes.size(); k-- > 0;)
@@ -275,8 +301,10 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
   // nodes: distributed, a node no evaluation of this process can open keeps only its moments (EmitTop).
   std::vector<TopShape> shapes(nc - 1);
   this->ShapeTop(leaves, 0, nc, 0, shapes);
-  this->Root = this->EmitTop(leaves, 0, nc, 0, shapes, d && lattice ? d : nullptr);
-  this->Total = this->Nodes[this->Root].Area;
+  const Distribution* prune = d && lattice ? d : nullptr;
+  this->Top.reserve(this->CountTop(leaves, 0, nc, 0, shapes, prune));
+  this->Root = this->EmitTop(leaves, 0, nc, 0, shapes, prune);
+  this->Total = this->NodeAt(this->Root).Area;
 }
 
 namespace
@@ -403,7 +431,7 @@ Index WindingNumber::EmitTop(const std::vector<TopLeaf>& leaves, size_t begin, s
   {
     node = this->LeafNode(leaves[begin]);
   }
-  else if (d && -d->Complete(shapes[index].Centre) > 1.001 * std::sqrt(this->Beta2) * shapes[index].Radius)
+  else if (this->Pruned(shapes[index], d))
   {
     // Every evaluation is made where the local cloud is complete (Distribution::Complete(x) >= 0); a node whose
     // centre lies farther than Beta radii from there is never opened: its moments stand for its subtree, whose nodes
@@ -417,10 +445,31 @@ Index WindingNumber::EmitTop(const std::vector<TopLeaf>& leaves, size_t begin, s
     node.Begin = node.End = 0;
     node.Left = this->EmitTop(leaves, begin, mid, index + 1, shapes, d);
     node.Right = this->EmitTop(leaves, mid, end, index + (mid - begin), shapes, d);
-    this->Combine(node, this->Nodes[node.Left], this->Nodes[node.Right]);
+    this->Combine(node, this->NodeAt(node.Left), this->NodeAt(node.Right));
   }
-  this->Nodes.push_back(node);
-  return static_cast<Index>(this->Nodes.size() - 1);
+  this->Top.push_back(node);
+  return static_cast<Index>(this->Nodes.size() + this->Top.size() - 1);
+}
+
+bool WindingNumber::Pruned(const TopShape& shape, const Distribution* d) const
+{
+  return d && -d->Complete(shape.Centre) > 1.001 * std::sqrt(this->Beta2) * shape.Radius;
+}
+
+size_t WindingNumber::CountTop(const std::vector<TopLeaf>& leaves, size_t begin, size_t end, size_t index,
+  const std::vector<TopShape>& shapes, const Distribution* d) const
+{
+  if (end - begin == 1)
+  {
+    return leaves[begin].Held >= 0 ? 0 : 1;
+  }
+  if (this->Pruned(shapes[index], d))
+  {
+    return 1;
+  }
+  const size_t mid = begin + (end - begin) / 2;
+  return 1 + this->CountTop(leaves, begin, mid, index + 1, shapes, d) +
+    this->CountTop(leaves, mid, end, index + (mid - begin), shapes, d);
 }
 
 void WindingNumber::Combine(Node& node, const Node& left, const Node& right) const
@@ -500,18 +549,18 @@ Index WindingNumber::BuildNode(Index begin, Index end, std::vector<Item>& items)
 
 double WindingNumber::DipoleLength() const
 {
-  if (this->Nodes.empty())
+  if (this->Nodes.empty() && this->Top.empty())
   {
     return 0.0;
   }
-  const double* m = this->Nodes[this->Root].Moment;
+  const double* m = this->NodeAt(this->Root).Moment;
   return std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
 }
 
 double WindingNumber::Evaluate(const double x[3], double gradient[3]) const
 {
   double w = 0.0, g[3] = { 0.0, 0.0, 0.0 };
-  if (this->Nodes.empty())
+  if (this->Nodes.empty() && this->Top.empty())
   {
     if (gradient)
     {
@@ -524,7 +573,7 @@ double WindingNumber::Evaluate(const double x[3], double gradient[3]) const
   stack[top++] = this->Root;
   while (top > 0)
   {
-    const Node& node = this->Nodes[stack[--top]];
+    const Node& node = this->NodeAt(stack[--top]);
     const double r[3] = { node.Centre[0] - x[0], node.Centre[1] - x[1], node.Centre[2] - x[2] };
     const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
     if (r2 > this->Beta2 * node.Radius * node.Radius)
@@ -584,8 +633,9 @@ double WindingNumber::Evaluate(const double x[3], double gradient[3]) const
         const double* n = &this->Normals[3 * s];
         const double d[3] = { p[0] - x[0], p[1] - x[1], p[2] - x[2] };
         const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        const double soft = d2 < this->Soft2[s];
-        const double e2 = soft ? this->Soft2[s] : d2;
+        const double soft2 = this->Areas[s] / M_PI; // the regularisation radius squared (class comment)
+        const double soft = d2 < soft2;
+        const double e2 = soft ? soft2 : d2;
         const double inv3 = 1.0 / (e2 * std::sqrt(e2));
         const double nd = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
         const double a = this->Areas[s] * kInverseFourPi * inv3;
@@ -618,7 +668,7 @@ double WindingNumber::EvaluateDirect(const double x[3]) const
     const double* p = &this->Points[3 * s];
     const double* n = &this->Normals[3 * s];
     const double d[3] = { p[0] - x[0], p[1] - x[1], p[2] - x[2] };
-    const double e2 = std::max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2], this->Soft2[s]);
+    const double e2 = std::max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2], this->Areas[s] / M_PI);
     w += this->Areas[s] * kInverseFourPi * (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]) / (e2 * std::sqrt(e2));
   }
   return w;

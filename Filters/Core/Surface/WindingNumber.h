@@ -123,13 +123,25 @@ private:
   /// Stores the top node over leaves[begin, end) and the descendants this process needs (d: see the definition).
   Index EmitTop(const std::vector<TopLeaf>& leaves, size_t begin, size_t end, size_t index,
     const std::vector<TopShape>& shapes, const Distribution* d);
+  /// Whether this process never opens the top node of that shape (every evaluation is made where its cloud is
+  /// complete, and the node lies farther than Beta radii from there); serial (d null): never pruned.
+  bool Pruned(const TopShape& shape, const Distribution* d) const;
+  /// How many nodes EmitTop stores over leaves[begin, end) (reserved at once: issue 24's memory per rank).
+  size_t CountTop(const std::vector<TopLeaf>& leaves, size_t begin, size_t end, size_t index,
+    const std::vector<TopShape>& shapes, const Distribution* d) const;
+  /// A node by index: the cubes' trees first (Nodes), then the top tree's (Top).
+  const Node& NodeAt(Index k) const
+  {
+    const size_t cube = this->Nodes.size();
+    return static_cast<size_t>(k) < cube ? this->Nodes[static_cast<size_t>(k)] : this->Top[static_cast<size_t>(k) - cube];
+  }
   /// `node`'s moments from its two children's.
   void Combine(Node& node, const Node& left, const Node& right) const;
-  std::vector<Node> Nodes;
+  std::vector<Node> Nodes, Top; // the cubes' trees (each allocated at its exact size), the top tree over them
   Index Root = 0;
   double BuildShortfall = -HUGE_VAL;
   mutable std::atomic<bool> Opened{ false };
-  std::vector<double> Points, Normals, Areas, Soft2; // tree order; Soft2: regularisation radius squared
+  std::vector<double> Points, Normals, Areas; // tree order (a point's regularisation radius squared: Areas / pi)
   double Beta2 = 4.0;
   double Total = 0.0;
 };
