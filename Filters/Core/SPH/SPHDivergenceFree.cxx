@@ -389,13 +389,14 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
           const double k = coefficient(x + 3 * static_cast<Index>(fn[s]), r);
           GradientPair& out = pair[s];
           out.Neighbor = fn[s];
+          double g[3];
           for (int a = 0; a < 3; ++a)
           {
             out.Gradient[a] = static_cast<float>(k * r[a]);
-            const double g = out.Gradient[a];
-            sum[a] += g;
-            squares += g * g;
+            g[a] = out.Gradient[a];
+            sum[a] += g[a];
           }
+          squares += g[0] * g[0] + g[1] * g[1] + g[2] * g[2]; // one addition a pair on the running sum
         }
         const double fluidSum[3] = { sum[0], sum[1], sum[2] };
         for (Index s = bs[i]; s < bs[i + 1]; ++s)
