@@ -113,6 +113,18 @@
 // Every sum is a particle's own, over its CSR rows in their order; the averages are fixed-block reductions
 // (ParallelReduce): the result does not depend on the number of threads.
 //
+// Pair list (issue 25, the cost of a step). The fields pass (step 1) writes, for every fluid pair of the CSR rows,
+// the neighbour j and G_ij rounded to single precision into one array (SPHGradientPair, 16 bytes a pair; the double
+// gradients it replaces took 24, and the passes read the 4-byte neighbour index from the rows besides). The
+// solves' two passes per iteration (B d, A d) stream it and gather w_j or v_j: no grid walk, no distance, no kernel.
+// The rounding keeps G_ji = -G_ij exact, and the own sums sum_f G are taken from the rounded G_ij, so the impulse
+// and the density rate remain each other's adjoint (A symmetric). The passes are not limited by memory but by the
+// additions' latency and the instruction count (a row of ~30 pairs summed into one accumulator): each component
+// is summed in two interleaved partial sums (the row's even and odd entries), two components at a time with SSE2
+// (RowImpulse, RowRate); d . A d and the step's limit are reduced in the A d pass, and the CG update of q, r, v in
+// the preconditioning pass. Same iterations as the double, single-accumulator passes on the benchmarks (the bits
+// differ); measured in results/spheric2.md, "Time to solution".
+//
 // The hydrostatic column (TestSPHDivergenceFree; issue 25). Until a-d below were changed it never came to rest:
 // its particles kept rearranging at speeds of order sqrt(g dx) and its pressure's relative L2 error against rho0 g
 // (H - z) was 0.91 (2D) and 0.66 (3D). With a-d and the solves converged (tolerances 1e-4 %) it rests and the
@@ -175,6 +187,9 @@
 #include <cstring>
 #include <limits>
 #include <sstream>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace meshfree
 {
@@ -186,6 +201,121 @@ constexpr int MinimumIterations = 2;      // corrections per solve after a warm 
 constexpr double ResidualReduction = 0.3; // the density solve reduces its error's RMS to 0.3 of its start ...
 constexpr double ReductionFloor = 0.01;   // ... unless its average error is below 1 % of the tolerance
 constexpr int SmoothingShape = 0;         // the Pressure output's Shepard weights: poly6's shape (h^2 - r^2)^3
+
+using GradientPair = SPHGradientPair;
+
+// The solves' two sums over a particle's row of fluid pairs [begin, end): sum_j w_j G_ij (RowImpulse) and
+// sum_j v_j . G_ij (RowRate). They are bound by the additions' latency and the instruction count, not by memory:
+// each component is summed in two interleaved partial sums (the row's even and odd entries) added at the end, two
+// components at a time with SSE2 where it is there; the scalar code does the same operations in the same order.
+inline void RowImpulse(const GradientPair* pair, Index begin, Index end, const double* w, double out[3])
+{
+  Index s = begin;
+#if defined(__SSE2__)
+  auto gradientXY = [](const GradientPair& p) {
+    return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p.Gradient))));
+  };
+  __m128d xy0 = _mm_setzero_pd(), xy1 = _mm_setzero_pd();
+  double z0 = 0.0, z1 = 0.0;
+  for (; s + 1 < end; s += 2)
+  {
+    const GradientPair& a = pair[s];
+    const GradientPair& b = pair[s + 1];
+    const double wa = w[a.Neighbor], wb = w[b.Neighbor];
+    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_set1_pd(wa), gradientXY(a)));
+    z0 += wa * static_cast<double>(a.Gradient[2]);
+    xy1 = _mm_add_pd(xy1, _mm_mul_pd(_mm_set1_pd(wb), gradientXY(b)));
+    z1 += wb * static_cast<double>(b.Gradient[2]);
+  }
+  if (s < end)
+  {
+    const double wa = w[pair[s].Neighbor];
+    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_set1_pd(wa), gradientXY(pair[s])));
+    z0 += wa * static_cast<double>(pair[s].Gradient[2]);
+  }
+  alignas(16) double xy[2];
+  _mm_store_pd(xy, _mm_add_pd(xy0, xy1));
+  out[0] = xy[0];
+  out[1] = xy[1];
+  out[2] = z0 + z1;
+#else
+  double even[3] = { 0.0, 0.0, 0.0 }, odd[3] = { 0.0, 0.0, 0.0 };
+  for (; s + 1 < end; s += 2)
+  {
+    const double wa = w[pair[s].Neighbor], wb = w[pair[s + 1].Neighbor];
+    for (int a = 0; a < 3; ++a)
+    {
+      even[a] += wa * static_cast<double>(pair[s].Gradient[a]);
+      odd[a] += wb * static_cast<double>(pair[s + 1].Gradient[a]);
+    }
+  }
+  if (s < end)
+  {
+    const double wa = w[pair[s].Neighbor];
+    for (int a = 0; a < 3; ++a)
+    {
+      even[a] += wa * static_cast<double>(pair[s].Gradient[a]);
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    out[a] = even[a] + odd[a];
+  }
+#endif
+}
+
+inline double RowRate(const GradientPair* pair, Index begin, Index end, const double* v)
+{
+  Index s = begin;
+#if defined(__SSE2__)
+  auto gradientXY = [](const GradientPair& p) {
+    return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p.Gradient))));
+  };
+  __m128d xy0 = _mm_setzero_pd(), xy1 = _mm_setzero_pd();
+  double z0 = 0.0, z1 = 0.0;
+  for (; s + 1 < end; s += 2)
+  {
+    const GradientPair& a = pair[s];
+    const GradientPair& b = pair[s + 1];
+    const double* va = v + 3 * static_cast<Index>(a.Neighbor);
+    const double* vb = v + 3 * static_cast<Index>(b.Neighbor);
+    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_loadu_pd(va), gradientXY(a)));
+    z0 += va[2] * static_cast<double>(a.Gradient[2]);
+    xy1 = _mm_add_pd(xy1, _mm_mul_pd(_mm_loadu_pd(vb), gradientXY(b)));
+    z1 += vb[2] * static_cast<double>(b.Gradient[2]);
+  }
+  if (s < end)
+  {
+    const double* va = v + 3 * static_cast<Index>(pair[s].Neighbor);
+    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_loadu_pd(va), gradientXY(pair[s])));
+    z0 += va[2] * static_cast<double>(pair[s].Gradient[2]);
+  }
+  alignas(16) double xy[2];
+  _mm_store_pd(xy, _mm_add_pd(xy0, xy1));
+  return (xy[0] + xy[1]) + (z0 + z1);
+#else
+  double even[3] = { 0.0, 0.0, 0.0 }, odd[3] = { 0.0, 0.0, 0.0 };
+  for (; s + 1 < end; s += 2)
+  {
+    const double* va = v + 3 * static_cast<Index>(pair[s].Neighbor);
+    const double* vb = v + 3 * static_cast<Index>(pair[s + 1].Neighbor);
+    for (int a = 0; a < 3; ++a)
+    {
+      even[a] += va[a] * static_cast<double>(pair[s].Gradient[a]);
+      odd[a] += vb[a] * static_cast<double>(pair[s + 1].Gradient[a]);
+    }
+  }
+  if (s < end)
+  {
+    const double* va = v + 3 * static_cast<Index>(pair[s].Neighbor);
+    for (int a = 0; a < 3; ++a)
+    {
+      even[a] += va[a] * static_cast<double>(pair[s].Gradient[a]);
+    }
+  }
+  return ((even[0] + odd[0]) + (even[1] + odd[1])) + (even[2] + odd[2]);
+#endif
+}
 }
 
 bool SPHFluid::FieldsMatch(const SPHState& state) const
@@ -214,7 +344,7 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
   state.Density.resize(n);
   this->InverseDensity.resize(n);
   this->Alpha.resize(n);
-  this->PairGradient.resize(3 * fs[n]);
+  this->Pairs.resize(fs[n]);
   this->WallCoefficient.resize(bs[n]);
   this->SelfGradient.resize(3 * n);
   this->GradientStrength.resize(n);
@@ -223,7 +353,7 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
   const SPHDensityConstants dc = SPHDensityConstantsOf(c);
   const double cutoff = 1e-9 * this->LatticeFactorSum;
   double* rho = state.Density.data();
-  double* pair = this->PairGradient.data();
+  GradientPair* pair = this->Pairs.data();
   double* wall = this->WallCoefficient.data();
   double* self = this->SelfGradient.data();
   ParallelFor(
@@ -237,8 +367,11 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
         // and, in the same pass, m grad W_ij = -G_ij, G_ij = coefficient (x_i - x_j), coefficient = m GradientNorm
         // shape(r) >= 0.
         SPHDensitySum density(dc);
-        auto coefficient = [&](const double* xj, double* out) {
-          const double r[3] = { xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2] };
+        auto coefficient = [&](const double* xj, double* r) {
+          for (int a = 0; a < 3; ++a)
+          {
+            r[a] = xi[a] - xj[a];
+          }
           const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
           density.Add(r2, dc);
           double k = 0.0;
@@ -246,28 +379,35 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
           {
             k = c.PressureFactor * SPHGradientShape(r2, std::sqrt(r2), c.H, c.H2, c.SpikyGradient);
           }
-          *out = k;
           strength += k * r2; // each wall dummy once: it fills its lattice site
-          for (int a = 0; a < 3; ++a)
-          {
-            sum[a] += k * r[a];
-          }
-          return k * k * r2;
+          return k;
         };
+        // The fluid pairs' G_ij as the solves use them: rounded to float (the pair list), the sums from those.
         for (Index s = fs[i]; s < fs[i + 1]; ++s)
         {
-          const double* xj = x + 3 * static_cast<Index>(fn[s]);
-          double k;
-          squares += coefficient(xj, &k);
+          double r[3];
+          const double k = coefficient(x + 3 * static_cast<Index>(fn[s]), r);
+          GradientPair& out = pair[s];
+          out.Neighbor = fn[s];
+          double g[3];
           for (int a = 0; a < 3; ++a)
           {
-            pair[3 * s + a] = k * (xi[a] - xj[a]);
+            out.Gradient[a] = static_cast<float>(k * r[a]);
+            g[a] = out.Gradient[a];
+            sum[a] += g[a];
           }
+          squares += g[0] * g[0] + g[1] * g[1] + g[2] * g[2]; // one addition a pair on the running sum
         }
         const double fluidSum[3] = { sum[0], sum[1], sum[2] };
         for (Index s = bs[i]; s < bs[i + 1]; ++s)
         {
-          coefficient(bx + 3 * static_cast<Index>(bn[s]), wall + s); // static: no term of their own
+          double r[3];
+          const double k = coefficient(bx + 3 * static_cast<Index>(bn[s]), r); // static: no term of their own
+          wall[s] = k;
+          for (int a = 0; a < 3; ++a)
+          {
+            sum[a] += k * r[a];
+          }
         }
         for (int a = 0; a < 3; ++a)
         {
@@ -341,11 +481,10 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
   const SPHParameters& p = this->Params;
   const Index n = state.Size();
   const Index* fs = this->FluidStart.data();
-  const std::int32_t* fn = this->FluidNeighbors.data();
   const double* rho = state.Density.data();
   const double* inverse = this->InverseDensity.data();
   const double* alpha = this->Alpha.data();
-  const double* pair = this->PairGradient.data();
+  const GradientPair* pair = this->Pairs.data();
   const double* self = this->SelfGradient.data();
   double* v = state.Velocity.data();
   std::vector<double>& stored = density ? state.DensityStiffness : state.DivergenceStiffness;
@@ -354,7 +493,6 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
   // preconditioned residual z, A d, and the velocity change B d.
   this->Kappa.resize(n);
   this->KappaOverRho.resize(n);
-  this->OldCompression.resize(n);
   this->SolveResidual.resize(n);
   this->SolveDirection.assign(n, 0.0);
   this->SolvePreconditioned.resize(n);
@@ -369,7 +507,6 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
   double* ad = this->SolveProduct.data();
   double* u = this->SolveVelocity.data();
   char* isFree = this->SolveFree.data();
-  double* compression = this->OldCompression.data();
   const double rho0 = p.RestDensity;
   const double tolerance = 0.01 * (density ? p.DensityTolerance : p.DivergenceTolerance);
   const bool flat = p.Dimension == 2;
@@ -384,15 +521,8 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
       [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
-          double dv[3] = { 0.0, 0.0, 0.0 };
-          for (Index s = fs[i]; s < fs[i + 1]; ++s)
-          {
-            const double wj = w[fn[s]];
-            const double* gs = pair + 3 * s;
-            dv[0] += wj * gs[0];
-            dv[1] += wj * gs[1];
-            dv[2] += wj * gs[2];
-          }
+          double dv[3];
+          RowImpulse(pair, fs[i], fs[i + 1], w, dv);
           const double* gi = self + 3 * i;
           dv[0] += w[i] * gi[0];
           dv[1] += w[i] * gi[1];
@@ -420,26 +550,23 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
   // out_i = e_i: the density error min(rho_i - rho0, overlap) + dt Drho/Dt_i (density solve) or the density rate
   // Drho/Dt_i (divergence solve) of the velocities `vel`; with offset = false the part linear in vel only, so
   // that out = -(A w) for vel = B w.
+  auto errorAt = [&](const double* vel, Index i, bool offset) {
+    // Drho/Dt = sum_j m (v_i - v_j) . grad W_ij = -sum_j (v_i - v_j) . G_ij - sum_b 2 v_i . G_ib: the mirrored
+    // dummy moves with -v_i (as its pressure is p_i), the adjoint of the push's factor 2; computed as
+    // sum_j v_j . G_ij - v_i . (sum_j G_ij + 2 sum_b G_ib).
+    const double* vi = vel + 3 * i;
+    double rate = RowRate(pair, fs[i], fs[i + 1], vel);
+    const double* gi = self + 3 * i;
+    rate -= vi[0] * gi[0] + vi[1] * gi[1] + vi[2] * gi[2];
+    return density ? (offset ? std::min(rho[i] - rho0, overlap) : 0.0) + dt * rate : rate;
+  };
   auto errors = [&](const double* vel, double* out, bool offset) {
     ParallelFor(
       n, 512,
       [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
-          // Drho/Dt = sum_j m (v_i - v_j) . grad W_ij = -sum_j (v_i - v_j) . G_ij - sum_b 2 v_i . G_ib: the
-          // mirrored dummy moves with -v_i (as its pressure is p_i), the adjoint of the push's factor 2; computed
-          // as sum_j v_j . G_ij - v_i . (sum_j G_ij + 2 sum_b G_ib).
-          const double* vi = vel + 3 * i;
-          double rate = 0.0;
-          for (Index s = fs[i]; s < fs[i + 1]; ++s)
-          {
-            const double* vj = vel + 3 * static_cast<Index>(fn[s]);
-            const double* gs = pair + 3 * s;
-            rate += vj[0] * gs[0] + vj[1] * gs[1] + vj[2] * gs[2];
-          }
-          const double* gi = self + 3 * i;
-          rate -= vi[0] * gi[0] + vi[1] * gi[1] + vi[2] * gi[2];
-          out[i] = density ? (offset ? std::min(rho[i] - rho0, overlap) : 0.0) + dt * rate : rate;
+          out[i] = errorAt(vel, i, offset);
         }
       },
       ParallelThreshold);
@@ -480,15 +607,25 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
   };
   // z on the free set, r . z there, the chopped gradient's size off it (particles at P = 0 that a positive
   // error would lift), and the error measures: average and squares of max(e, 0) (a fraction of rho0).
-  auto precondition = [&](bool choose) {
+  // With step != 0 it first takes the CG step on particle i (q, r and v along d, A d and B d: the update fused
+  // into this pass).
+  auto precondition = [&](bool choose, double step) {
     return ParallelReduce(
       n, 4096, Sums(),
       [&](Index begin, Index end) {
         Sums sum;
         for (Index i = begin; i < end; ++i)
         {
+          if (step != 0.0)
+          {
+            q[i] = std::max(q[i] + step * d[i], 0.0);
+            r[i] -= step * ad[i];
+            for (int a = 0; a < 3; ++a)
+            {
+              v[3 * i + a] += step * u[3 * i + a];
+            }
+          }
           const double c = std::max(r[i], 0.0) * scale;
-          compression[i] = c;
           sum.Compression += c;
           sum.Squares += c * c;
           if (choose)
@@ -514,14 +651,23 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
       },
       combine, ParallelThreshold);
   };
+  // d = z + beta d (beta = 0: restart on z).
+  auto direction = [&](double beta) {
+    ParallelFor(
+      n, 4096,
+      [&](Index begin, Index end) {
+        for (Index i = begin; i < end; ++i)
+        {
+          d[i] = beta == 0.0 ? z[i] : z[i] + beta * d[i];
+        }
+      },
+      ParallelThreshold);
+  };
   errors(v, r, true);
-  Sums sums = precondition(true);
+  Sums sums = precondition(true, 0.0);
   const double startSquares = sums.Squares;
   double rz = sums.Rz;
-  for (Index i = 0; i < n; ++i)
-  {
-    d[i] = z[i];
-  }
+  direction(0.0);
   int iterations = 0;
   const double count = static_cast<double>(std::max<Index>(n, 1));
   for (;;)
@@ -542,18 +688,19 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
       break; // no free particle has an error left to correct (the rest have alpha = 0)
     }
     impulse(d, u, false);
-    errors(u, ad, false);
+    // A d = -(the error's linear part at u = B d), with d . A d and the largest step that keeps q >= 0 reduced in
+    // the same pass.
     struct Step
     {
       double DAd = 0.0, Limit = std::numeric_limits<double>::infinity();
     };
     const Step st = ParallelReduce(
-      n, 4096, Step(),
+      n, 1024, Step(),
       [&](Index begin, Index end) {
         Step s;
         for (Index i = begin; i < end; ++i)
         {
-          ad[i] = -ad[i];
+          ad[i] = -errorAt(u, i, false);
           s.DAd += d[i] * ad[i];
           if (d[i] < 0.0)
           {
@@ -593,45 +740,26 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
       impulse(dq, v, true);
       errors(v, r, true);
       restart = true;
+      sums = precondition(false, 0.0);
     }
     else
     {
-      ParallelFor(
-        n, 2048,
-        [&](Index begin, Index end) {
-          for (Index i = begin; i < end; ++i)
-          {
-            q[i] = std::max(q[i] + step * d[i], 0.0);
-            r[i] -= step * ad[i];
-            for (int a = 0; a < 3; ++a)
-            {
-              v[3 * i + a] += step * u[3 * i + a];
-            }
-          }
-        },
-        ParallelThreshold);
+      sums = precondition(false, step);
     }
-    sums = precondition(false);
     // Proportioning (Dostal's criterion with Gamma = 1): when the particles held at P = 0 have more error to
     // correct than the free ones, restart with them freed.
     restart = restart || sums.Chopped > sums.Rz;
     if (restart)
     {
-      sums = precondition(true);
+      sums = precondition(true, 0.0);
       rz = sums.Rz;
-      for (Index i = 0; i < n; ++i)
-      {
-        d[i] = z[i];
-      }
+      direction(0.0);
     }
     else
     {
       const double beta = sums.Rz / rz;
       rz = sums.Rz;
-      for (Index i = 0; i < n; ++i)
-      {
-        d[i] = z[i] + beta * d[i];
-      }
+      direction(beta);
     }
   }
   for (Index i = 0; i < n; ++i)

@@ -193,6 +193,14 @@ struct SPHStatistics
   bool Finite = true;
 };
 
+/// DFSPH's pair list entry (SPHDivergenceFree.cxx): a fluid neighbour j of particle i and G_ij = -m grad W_ij in
+/// single precision, 16 bytes.
+struct SPHGradientPair
+{
+  float Gradient[3];
+  std::int32_t Neighbor;
+};
+
 class SPHFluid
 {
 public:
@@ -310,10 +318,13 @@ private:
   void DivergenceFreeOutput(SPHState& state);
   bool ChooseDivergenceFreeStep(const SPHState& state, double time, double targetTime, long steps, double& dt,
     bool& last);
-  // G_ij = m GradientNorm shape(r) (x_i - x_j) of every fluid pair (3 per pair, in the CSR rows' order), the wall
-  // pairs' coefficients m GradientNorm shape(r), and each particle's own sum_f G + 2 sum_b G (3 per particle).
-  std::vector<double> PairGradient, WallCoefficient, SelfGradient;
-  std::vector<double> Alpha, Kappa, KappaOverRho, OldCompression, OldVelocity, Smoothed;
+  // Every fluid pair of the CSR rows, in their order: the neighbour j and G_ij = m GradientNorm shape(r) (x_i - x_j)
+  // rounded to single precision (16 bytes a pair, one stream: the solves' passes read nothing else per pair; the
+  // rounding keeps G_ji = -G_ij exact). The wall pairs' coefficients m GradientNorm shape(r), and each particle's own
+  // sum_f G + 2 sum_b G (3 per particle, the fluid part summed from the rounded G_ij).
+  std::vector<SPHGradientPair> Pairs;
+  std::vector<double> WallCoefficient, SelfGradient;
+  std::vector<double> Alpha, Kappa, KappaOverRho, OldVelocity, Smoothed;
   // DFSPH: each particle's pressure impulse, sum over the steps of the current Advance() call of dt rho (kappa_density
   // + kappa_divergence) (permuted with the particles by Reorder), and the time those steps span: the Pressure output
   // is its time average (SPHDivergenceFree.cxx, "Pressure output").
