@@ -332,7 +332,8 @@ int vtkMeshlessNormals::RequestData(
     local->SetName("LocalCloudPoints");
     local->InsertNextValue(run.Held);
     fd->AddArray(local);
-    vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", run.Radius);
+    // -1 when the halo was the whole cloud (an infinite radius; no Inf leaves the filter).
+    vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", std::isfinite(run.Radius) ? run.Radius : -1.0);
     vtkNew<vtkIdTypeArray> rounds;
     rounds->SetName("HaloAttempts");
     rounds->InsertNextValue(run.Attempts);

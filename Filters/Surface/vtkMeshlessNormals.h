@@ -37,7 +37,7 @@
  * the global steps are distributed too: the scale estimate's sample (chosen by a hash of the positions),
  * the medians (exact selections over the ranks), the orientation (blocks oriented where their points are, then
  * the same small graph of blocks solved on every rank) and the duplicates (each owned where its smallest global
- * id is). Memory per rank: its piece and halo (field data `LocalCloudPoints`, `HaloRadius`, `HaloAttempts`, per
+ * id is). Memory per rank: its piece and halo (field data `LocalCloudPoints`, `HaloRadius` (-1 when it was the whole cloud), `HaloAttempts`, per
  * rank); pieces compact in space (slabs, RedistributeDataSet) keep the halo a band along their faces, pieces
  * split by index span the whole cloud and hold all of it. An input that every rank holds whole (piece 0 of 1 on
  * each rank) is computed locally, without communication.

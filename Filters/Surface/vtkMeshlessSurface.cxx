@@ -805,7 +805,8 @@ int vtkMeshlessSurface::ReconstructDistributed(
   local->SetName("LocalCloudPoints");
   local->InsertNextValue(held);
   fd->AddArray(local);
-  vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", radius);
+  // -1 when the halo was the whole cloud (an infinite radius; no Inf leaves the filter).
+  vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloRadius", std::isfinite(radius) ? radius : -1.0);
   vtkMeshFreeFilterSupport::AddFieldValue(fd, "HaloAttempts", attempts);
   // The halo width the last attempt needed: its radius less the slack every computation left (or plus its shortfall);
   // 0 when not known (no computation measured it, or the halo was the whole cloud).

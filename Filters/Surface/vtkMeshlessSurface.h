@@ -49,7 +49,7 @@
  *   vertex on a seam is on both ranks). HoleFilling's winding number sums over every point: each rank sums the
  *   cubes near it from its halo and the others by their moments, gathered from their owners (WindingNumber.h).
  *   Stray pieces are judged on the whole mesh (pieces joined across the seams). A rank holds its slab and a band of
- *   halo, never the whole cloud unless the halo needs it (field data `LocalCloudPoints`, `HaloRadius`,
+ *   halo, never the whole cloud unless the halo needs it (field data `LocalCloudPoints`, `HaloRadius` (-1 when it was the whole cloud),
  *   `HaloAttempts`, per rank). Each rank's output is its slab's part (not the ParaView piece it was given). The
  *   SPH method's kernel radius and bulk volume come from a sample of particles chosen by a hash of their positions
  *   (the same sample in any order and split), evaluated where each is owned.

@@ -194,6 +194,8 @@ def held_share(local, label, split, count, max_share):
         most = mm.all_gather(np.array([[held.GetTuple1(0)]]))[:, 0].max()
         radius = local.GetFieldData().GetArray("HaloRadius").GetTuple1(0)
         attempts = local.GetFieldData().GetArray("HaloAttempts").GetTuple1(0)
+        mm.check(np.isfinite(radius) and (radius > 0 or radius == -1),
+                 f"{label} ({split}): HaloRadius {radius} is neither a width nor -1 (the whole cloud)")
         if mm.RANK == 0:
             mm.log(f"{label} ({split}): at most {int(most)} of {count} points on a rank "
                    f"(halo radius {radius:.3g}, {int(attempts)} attempt(s))")

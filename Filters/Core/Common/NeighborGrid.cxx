@@ -452,6 +452,12 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   return true;
 }
 
+void NeighborGrid::ReleaseBuildScratch()
+{
+  detail::Buffer<std::uint64_t>().swap(this->CellKeys);
+  detail::Buffer<std::uint64_t>().swap(this->SortScratch);
+}
+
 int NeighborGrid::MortonTables(const Index dims[3], std::vector<std::uint64_t> spread[3])
 {
   int axisBits[3];

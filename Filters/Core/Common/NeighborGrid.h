@@ -227,6 +227,9 @@ public:
   const double* SortedPoints() const { return this->Sorted.data(); }
   const CellRange* Cells() const { return this->CellRanges.data(); }
   ///@}
+  /// Lets go of Build()'s sort scratch (16 bytes per point, kept so that a grid rebuilt every step, as SPH's, does
+  /// not reallocate): for a grid built once. The grid stays as it is; a later Build() allocates it again.
+  void ReleaseBuildScratch();
 
   ///@{
   /// The geometry Build() uses, for code that reproduces the grid elsewhere (the CUDA SPH integrator builds its

@@ -86,6 +86,7 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
   {
     return;
   }
+  std::vector<double>().swap(supports);
   this->NearRadius = bounds.front();
   this->Tiers.resize(bounds.size());
   std::vector<std::vector<double>> coordinates(bounds.size());
@@ -134,6 +135,11 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     {
       tier.Positions[w] = positions[t][static_cast<size_t>(order[w])];
     }
+    // Built once: the tier's copies and the grid's sort scratch go now (this is where a distributed surface's
+    // memory peaks: issue 24).
+    tier.Grid.ReleaseBuildScratch();
+    std::vector<double>().swap(coordinates[t]);
+    std::vector<Index>().swap(positions[t]);
   }
 }
 

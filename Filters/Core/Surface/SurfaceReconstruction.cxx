@@ -401,6 +401,8 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     }
   }
 
+  grid.ReleaseBuildScratch(); // built for good
+
   std::unique_ptr<ImplicitField> field; // the surface contoured
   std::unique_ptr<ImplicitField> fit;   // MLS/WLS with holes filled: the fits the field continues
   NormalField normals;
