@@ -1,14 +1,16 @@
 // Meshless Normals' core (ComputeCloudNormals) on bench_scale.py's scan-like cloud, without VTK: the time of
 // its stages and a digest of every output array's bits (to check that a speed-up leaves the results unchanged).
 // Usage: BenchCloudNormals [--points N] [--repeat R] [--curvature 0|1] [--shuffle 0|1] [--full 0|1] [--wide 0|1]
-//        [--support RADIUS] [--xyz CLOUD.xyz] [--noise FRACTION] [--accuracy 0|1] [--vector 0|1]
+//        [--support RADIUS] [--xyz CLOUD.xyz] [--noise FRACTION] [--accuracy 0|1] [--vector 0|1] [--alone 0|1]
 // The cloud: a sphere (radius 0.5) inside a torus (R = 1, r = 0.25), points spread evenly over their area, each
 // moved along its normal by Gaussian noise of 0.1 % of the bounding box's diagonal (bench_scale.py's formula;
 // libm's log/cos may differ from numpy's in the last bit). --xyz reads "x y z" lines instead. --shuffle 1 permutes
 // the input (a fixed permutation) and digests the results in the original order: the digest must not change.
 // --wide 0 and --support R: NormalOptions::WideNormals and ::SupportRadius (Meshless Surface's narrow normals, a
 // fixed radius). Stages: the grid and EstimateNormals timed alone, then the whole ComputeCloudNormals (grid, normals,
-// orientation, curvature; --full 0 skips it and times the cloud's scale, EstimateCloudScale, alone instead). Threads: all the CPUs, or MESHFREE_NUM_THREADS.
+// orientation, curvature; --full 0 skips it and times the cloud's scale, EstimateCloudScale, alone instead;
+// --alone 0 skips the grid and EstimateNormals timed alone: ComputeCloudNormals only, as the plugin runs it, e.g.
+// under a profiler). Threads: all the CPUs, or MESHFREE_NUM_THREADS.
 // --noise: sigma as a fraction of the diagonal (default 0.001). --accuracy 1: the Curvature's relative error against
 // the exact mean curvature (sphere 1 / rs; torus (R + 2 r cos v) / (2 r (R + r cos v))), mean / p99 / max, separately
 // on the sphere and the torus (points with Curvature 0 or an invalid normal count as error 1).
@@ -158,7 +160,7 @@ int main(int argc, char** argv)
 {
   std::int64_t count = 1000000;
   int repeat = 1;
-  bool curvature = true, shuffle = false, full = true, accuracy = false;
+  bool curvature = true, shuffle = false, full = true, accuracy = false, alone = true;
   double noiseFraction = 0.001;
   std::string xyzFile;
   meshfree::NormalOptions neighborhood;
@@ -180,6 +182,10 @@ int main(int argc, char** argv)
     else if (key == "--full")
     {
       full = value != "0";
+    }
+    else if (key == "--alone")
+    {
+      alone = value != "0";
     }
     else if (key == "--shuffle")
     {
@@ -264,13 +270,17 @@ int main(int argc, char** argv)
     auto start = std::chrono::steady_clock::now();
     double cpu = CpuSeconds();
     meshfree::NeighborGrid grid;
-    grid.Build(xyz.data(), static_cast<meshfree::Index>(count));
-    const double gridSeconds = Seconds(start);
-    start = std::chrono::steady_clock::now();
-    meshfree::NormalField field;
-    meshfree::EstimateNormals(grid, neighborhood, field);
-    const double normalSeconds = Seconds(start);
-    const double normalCpu = CpuSeconds() - cpu;
+    double gridSeconds = 0.0, normalSeconds = 0.0, normalCpu = 0.0;
+    if (alone || !full)
+    {
+      grid.Build(xyz.data(), static_cast<meshfree::Index>(count));
+      gridSeconds = Seconds(start);
+      start = std::chrono::steady_clock::now();
+      meshfree::NormalField field;
+      meshfree::EstimateNormals(grid, neighborhood, field);
+      normalSeconds = Seconds(start);
+      normalCpu = CpuSeconds() - cpu;
+    }
 
     if (!full)
     {
@@ -309,9 +319,16 @@ int main(int argc, char** argv)
     }
     // ComputeCloudNormals builds its grid and estimates the normals again: beyond those, it orients them and fits
     // the curvature's spheres.
-    std::printf("grid %.3f s, EstimateNormals %.3f s (cpu %.3f s); ComputeCloudNormals %.3f s (cpu %.3f s, of "
-                "which orientation + curvature ~%.3f s cpu)\n",
-      gridSeconds, normalSeconds, normalCpu, totalSeconds, totalCpu, totalCpu - normalCpu);
+    if (alone)
+    {
+      std::printf("grid %.3f s, EstimateNormals %.3f s (cpu %.3f s); ComputeCloudNormals %.3f s (cpu %.3f s, of "
+                  "which orientation + curvature ~%.3f s cpu)\n",
+        gridSeconds, normalSeconds, normalCpu, totalSeconds, totalCpu, totalCpu - normalCpu);
+    }
+    else
+    {
+      std::printf("ComputeCloudNormals %.3f s (cpu %.3f s)\n", totalSeconds, totalCpu);
+    }
     std::printf("noise %.4g, spacing %.4g, normal radius %.4g, fits radius %.4g, fit noise %.4g, curvature %.4g, "
                 "invalid %lld, outliers %lld\n",
       result.Scale.Noise, result.Scale.Spacing, result.Scale.NormalRadius, result.Scale.Radius, result.Scale.FitNoise,

@@ -16,6 +16,9 @@
 #ifndef meshfree_Distribution_h
 #define meshfree_Distribution_h
 
+#include "Common/LargeArrays.h"
+
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
 #include <vector>
@@ -115,6 +118,7 @@ public:
   void Choose(const Distribution* d, const double* xyz, Index n, Index count, const Eligible& eligible)
   {
     std::vector<Candidate> candidates;
+    detail::ReserveLarge(candidates, static_cast<std::size_t>(n > 0 ? n : 0)); // no regrowth, huge pages
     for (Index i = 0; i < n; ++i)
     {
       if (eligible(i))

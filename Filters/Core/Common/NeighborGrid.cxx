@@ -358,6 +358,7 @@ bool NeighborGrid::Build(const double* xyz, Index n, double cellSize)
   }
 
   // Gather the coordinates in sorted order; keep the cell key of each sorted position for the cells.
+  detail::ReserveLarge(this->Order, static_cast<std::size_t>(m)); // a public std::vector: huge pages if fresh
   this->Order.resize(m);
   this->Sorted.resize(3 * m);
   keys = this->CellKeys.data();

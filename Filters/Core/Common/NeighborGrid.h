@@ -56,6 +56,7 @@
 #define meshfree_NeighborGrid_h
 
 #include "Common/GridCell.h"
+#include "Common/LargeArrays.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -70,10 +71,14 @@ using Index = std::int64_t;
 
 namespace detail
 {
-/// Allocator whose resize() leaves trivial elements uninitialised (the build writes them in parallel).
+/// Allocator whose resize() leaves trivial elements uninitialised (the build writes them in parallel), large
+/// blocks on huge pages (LargeArrays.h: their first touch is a fraction of the cost).
 template <class T>
 struct UninitializedAllocator : std::allocator<T>
 {
+  using value_type = T;
+  T* allocate(std::size_t n) { return static_cast<T*>(LargeAllocate(n * sizeof(T))); }
+  void deallocate(T* p, std::size_t n) noexcept { LargeFree(p, n * sizeof(T)); }
   template <class U>
   struct rebind
   {

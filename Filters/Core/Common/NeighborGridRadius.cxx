@@ -35,7 +35,7 @@ void NeighborGrid::FindWithinRadius(
 
 Index NeighborGrid::FindDuplicates(std::vector<Index>& representative) const
 {
-  representative.assign(static_cast<size_t>(this->NumberOfInputPoints), -1);
+  detail::AssignLarge(representative, static_cast<size_t>(this->NumberOfInputPoints), Index(-1));
   if (this->Order.empty())
   {
     return 0; // no valid point: no cell ranges either

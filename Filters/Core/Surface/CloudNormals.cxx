@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Surface/CloudNormals.h"
 
+#include "Common/LargeArrays.h"
 #include "Common/Parallel.h"
 #include "Surface/PointSetSurface.h"
 #include "Surface/UniqueCloud.h"
@@ -18,12 +19,12 @@ namespace
 /// The results of the distinct points given to every input point (invalid coordinates: invalid results).
 void ExpandDuplicates(const CloudNormalsResult& distinct, const UniqueCloud& unique, Index n, CloudNormalsResult& result)
 {
-  result.Normals.assign(static_cast<size_t>(3 * n), 0.0);
-  result.Curvature.assign(static_cast<size_t>(n), 0.0);
-  result.SurfaceVariation.assign(static_cast<size_t>(n), 0.0);
-  result.Confidence.assign(static_cast<size_t>(n), 0.0);
-  result.Radius.assign(static_cast<size_t>(n), 0.0);
-  result.Valid.assign(static_cast<size_t>(n), 0);
+  detail::AssignLarge(result.Normals, static_cast<size_t>(3 * n), 0.0);
+  detail::AssignLarge(result.Curvature, static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(result.SurfaceVariation, static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(result.Confidence, static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(result.Radius, static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(result.Valid, static_cast<size_t>(n), static_cast<unsigned char>(0));
   result.Invalid = 0;
   for (Index i = 0; i < n; ++i)
   {
@@ -73,7 +74,7 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
   const std::vector<Index>& order = grid.SortedOrder();
   const Index nv = static_cast<Index>(order.size());
   const int degree = field.GraphDegree;
-  std::vector<std::int32_t> rank(static_cast<size_t>(n), -1);
+  detail::Buffer<std::int32_t> rank(static_cast<size_t>(n), -1);
   ParallelFor(nv, 4096, [&](Index b0, Index b1) {
     for (Index s = b0; s < b1; ++s)
     {
@@ -81,8 +82,10 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
     }
   });
   // Per sorted position: the value signed along the oriented normal, and the neighbours that take part.
-  std::vector<double> k(static_cast<size_t>(nv), 0.0), next(static_cast<size_t>(nv), 0.0);
-  std::vector<std::int32_t> graph(static_cast<size_t>(nv) * degree, -1);
+  std::vector<double> k, next; // std::vector: UpdateHaloInOrder's
+  detail::AssignLarge(k, static_cast<size_t>(nv), 0.0);
+  detail::AssignLarge(next, static_cast<size_t>(nv), 0.0);
+  detail::Buffer<std::int32_t> graph(static_cast<size_t>(nv) * degree, -1);
   ParallelFor(nv, 4096, [&](Index b0, Index b1) {
     for (Index s = b0; s < b1; ++s)
     {
@@ -134,7 +137,7 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
       UpdateHaloInOrder(d, order, n, { &k });
     }
   }
-  curvature.assign(static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(curvature, static_cast<size_t>(n), 0.0);
   ParallelFor(nv, 4096, [&](Index b0, Index b1) {
     for (Index s = b0; s < b1; ++s)
     {
@@ -149,6 +152,7 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
 {
   const Distribution* d = options.Neighborhood.Processes;
   result = CloudNormalsResult();
+  detail::ReserveLarge(result.Points, static_cast<size_t>(3 * std::max<Index>(n, 0)));
   result.Points.assign(xyz, xyz + 3 * std::max<Index>(n, 0));
   NeighborGrid grid;
   if (options.Framed)
@@ -220,11 +224,12 @@ bool ComputeCloudNormals(const double* xyz, Index n, const double* referenceNorm
   std::vector<double> unoriented;
   if (jetCurvature)
   {
-    unoriented = field.Normals;
+    detail::ReserveLarge(unoriented, field.Normals.size());
+    unoriented.assign(field.Normals.begin(), field.Normals.end());
   }
   result.Orientation = OrientNormals(grid, field, orientation, result.Confidence);
   result.Shortfall = std::max(result.Shortfall, result.Orientation.Shortfall);
-  result.Curvature.assign(static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(result.Curvature, static_cast<size_t>(n), 0.0);
   if (jetCurvature)
   {
     SmoothJetCurvature(grid, field, unoriented, d, result.Curvature);

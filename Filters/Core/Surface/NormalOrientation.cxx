@@ -2,6 +2,7 @@
 // Minimum-spanning-tree propagation of normal orientation (NormalOrientation.h).
 #include "Surface/NormalOrientation.h"
 
+#include "Common/LargeArrays.h"
 #include "Common/Parallel.h"
 
 #include <algorithm>
@@ -267,7 +268,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
 {
   OrientationReport report;
   const Index n = static_cast<Index>(field.Valid.size());
-  confidence.assign(static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(confidence, static_cast<size_t>(n), 0.0);
   const Distribution* d = options.Processes;
 
 
@@ -300,10 +301,12 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   const double* xyz = grid.SortedPoints();
   const Index nv = static_cast<Index>(order.size());
   const int k = field.GraphDegree;
-  std::vector<std::int32_t> rank(static_cast<size_t>(n), -1);
-  std::vector<double> normals(static_cast<size_t>(3 * nv));
-  std::vector<unsigned char> valid(static_cast<size_t>(nv));
-  std::vector<double> sortedDistance(static_cast<size_t>(nv));
+  // The per-point arrays below on huge pages (detail::Buffer, Common/LargeArrays.h): fresh pages' faults were a
+  // large part of the orientation's time.
+  detail::Buffer<std::int32_t> rank(static_cast<size_t>(n), -1);
+  detail::Buffer<double> normals(static_cast<size_t>(3 * nv), 0.0);
+  detail::Buffer<unsigned char> valid(static_cast<size_t>(nv), 0);
+  detail::Buffer<double> sortedDistance(static_cast<size_t>(nv), 0.0);
   // In parallel (the reads by original index miss the cache: serially a third of the orientation's time at 1M
   // points), then the own valid points' r_k listed in sorted order as before.
   ParallelFor(nv, 4096, [&](Index b0, Index b1) {
@@ -317,6 +320,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     }
   });
   std::vector<double> distances;
+  detail::ReserveLarge(distances, static_cast<size_t>(nv));
   for (Index s = 0; s < nv; ++s)
   {
     if (valid[s] && IsOwn(d, order[s]))
@@ -324,7 +328,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       distances.push_back(sortedDistance[s]);
     }
   }
-  std::vector<double>().swap(sortedDistance);
+  detail::Buffer<double>().swap(sortedDistance);
 
   // The blocks: BlockNeighborhoods x the median r_k of the whole cloud, over the frame's cells.
   double frame[6];
@@ -342,7 +346,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     blocks.Origin[a] = std::isfinite(frame[2 * a]) ? frame[2 * a] : 0.0;
   }
   blocks.Inverse = 1.0 / edge;
-  std::vector<std::uint64_t> blockOf(static_cast<size_t>(nv), 0);
+  detail::Buffer<std::uint64_t> blockOf(static_cast<size_t>(nv), 0);
   ParallelFor(nv, 4096, [&](Index b0, Index b1) {
     for (Index s = b0; s < b1; ++s)
     {
@@ -372,7 +376,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
   // Their points, block by block, each block's in sorted order: (block key, sorted position) ascending, by a
   // counting sort over the blocks' indices in `wanted` (-1: not a wanted block).
-  std::vector<std::int32_t> blockIndex(static_cast<size_t>(nv), -1);
+  detail::Buffer<std::int32_t> blockIndex(static_cast<size_t>(nv), -1);
   ParallelFor(nv, 4096, [&](Index b0, Index b1) {
     std::uint64_t lastKey = 0;
     std::int32_t last = -2; // none looked up yet
@@ -392,7 +396,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     }
   });
   std::vector<size_t> blockBegin(wanted.size() + 1, 0);
-  std::vector<unsigned char> inBlock(static_cast<size_t>(nv), 0);
+  detail::Buffer<unsigned char> inBlock(static_cast<size_t>(nv), 0);
   for (Index s = 0; s < nv; ++s)
   {
     if (blockIndex[s] >= 0)
@@ -405,7 +409,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   {
     blockBegin[b + 1] += blockBegin[b];
   }
-  std::vector<std::pair<std::uint64_t, std::int32_t>> members(blockBegin.back());
+  detail::Buffer<std::pair<std::uint64_t, std::int32_t>> members(blockBegin.back(), std::pair<std::uint64_t, std::int32_t>());
   {
     std::vector<size_t> fill(blockBegin.begin(), blockBegin.end() - 1);
     for (Index s = 0; s < nv; ++s)
@@ -416,15 +420,15 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       }
     }
   }
-  std::vector<std::int32_t>().swap(blockIndex);
+  detail::Buffer<std::int32_t>().swap(blockIndex);
 
   // The graph's edges inside each block, symmetric, in compressed rows by sorted position (visited in sorted
   // order: a block's lists are the same on every process that holds the block).
-  std::vector<Index> offsets(static_cast<size_t>(nv + 1), 0);
+  detail::Buffer<Index> offsets(static_cast<size_t>(nv + 1), 0);
   // A chunk of sorted positions at a time: each point's graph neighbours in its block (as sorted positions, -1 when
   // not) found in parallel (reads by original index, which miss the cache), then visited in order.
   const Index edgeChunk = 65536;
-  std::vector<std::int32_t> linked(static_cast<size_t>(std::min(nv, edgeChunk)) * static_cast<size_t>(k));
+  detail::Buffer<std::int32_t> linked(static_cast<size_t>(std::min(nv, edgeChunk)) * static_cast<size_t>(k), 0);
   auto edges = [&](auto&& visit) {
     for (Index c0 = 0; c0 < nv; c0 += edgeChunk)
     {
@@ -463,25 +467,25 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   {
     offsets[s + 1] += offsets[s];
   }
-  std::vector<std::int32_t> adjacent(static_cast<size_t>(offsets[nv]));
+  detail::Buffer<std::int32_t> adjacent(static_cast<size_t>(offsets[nv]), 0);
   {
-    std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
+    detail::Buffer<Index> fill(offsets.begin(), offsets.end() - 1);
     edges([&](std::int32_t a, std::int32_t b) {
       adjacent[fill[a]++] = b;
       adjacent[fill[b]++] = a;
     });
   }
-  std::vector<std::int32_t>().swap(linked);
+  detail::Buffer<std::int32_t>().swap(linked);
 
   // Prim's propagation inside each block (blocks in parallel): components numbered in the block from its first
   // point in sorted order. Only edges whose normals agree up to sign within 60 degrees are followed: a block
   // across a sharp crease (a cube's edge) would otherwise turn one side by the sign of a single near-90-degree
   // pair; the crease's sides become separate nodes, joined by the nodes' summed votes, strongest first.
-  std::vector<double> sortedConfidence(static_cast<size_t>(nv), 0.0);
-  std::vector<unsigned char> done(static_cast<size_t>(nv), 0);
-  std::vector<std::int32_t> parent(static_cast<size_t>(nv), -1);
-  std::vector<std::int32_t> component(static_cast<size_t>(nv), -1);
-  std::vector<float> key(static_cast<size_t>(nv), std::numeric_limits<float>::infinity());
+  detail::Buffer<double> sortedConfidence(static_cast<size_t>(nv), 0.0);
+  detail::Buffer<unsigned char> done(static_cast<size_t>(nv), 0);
+  detail::Buffer<std::int32_t> parent(static_cast<size_t>(nv), -1);
+  detail::Buffer<std::int32_t> component(static_cast<size_t>(nv), -1);
+  detail::Buffer<float> key(static_cast<size_t>(nv), std::numeric_limits<float>::infinity());
   std::vector<std::int64_t> blockComponents(wanted.size(), 0);
   PerThread<BucketQueue> queues;
   ParallelFor(static_cast<Index>(wanted.size()), 1, [&](Index b0, Index b1) {

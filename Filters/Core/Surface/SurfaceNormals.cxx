@@ -4,6 +4,7 @@
 
 #include "Common/Distribution.h"
 #include "Common/GridCell.h"
+#include "Common/LargeArrays.h"
 #include "Common/LocalFit.h"
 #include "Common/Parallel.h"
 #include "Common/Statistics.h"
@@ -723,7 +724,7 @@ bool BuildThinnedClouds(const NeighborGrid& grid, int classes, std::vector<Neigh
   std::vector<std::vector<double>> xyz(static_cast<size_t>(classes));
   for (std::vector<double>& c : xyz)
   {
-    c.reserve(static_cast<size_t>(3 * (nv / classes + 1)));
+    detail::ReserveLarge(c, static_cast<size_t>(3 * (nv / classes + 1)));
   }
   Index begin = 0, first[3] = { 0, 0, 0 };
   if (nv > 0)
@@ -892,9 +893,9 @@ void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vect
   const Index nv = static_cast<Index>(order.size());
   const double noise = field.Scale.FitNoise;
   // The replaced normals, applied after the pass (it reads the first ones).
-  std::vector<double> replaced(static_cast<size_t>(3 * nv), 0.0);
-  std::vector<unsigned char> changed(static_cast<size_t>(nv), 0);
-  std::vector<double> replacedCurvature(meanCurvature ? static_cast<size_t>(nv) : 0, 0.0);
+  detail::Buffer<double> replaced(static_cast<size_t>(3 * nv), 0.0);
+  detail::Buffer<unsigned char> changed(static_cast<size_t>(nv), 0);
+  detail::Buffer<double> replacedCurvature(meanCurvature ? static_cast<size_t>(nv) : 0, 0.0);
   struct Buffers
   {
     std::vector<Index> Positions;
@@ -1000,6 +1001,8 @@ void FlagOutliers(NormalField& field, const Distribution* d)
 {
   std::vector<double> residuals, distances;
   const size_t n = field.Valid.size();
+  detail::ReserveLarge(residuals, n);
+  detail::ReserveLarge(distances, n);
   for (size_t i = 0; i < n; ++i)
   {
     if (field.Valid[i] && IsOwn(d, static_cast<Index>(i)))
@@ -1267,16 +1270,18 @@ bool EstimateNormals(
   const Distribution* d = options.Processes;
   const Index n = grid.NumberOfPoints();
   const int degree = std::max(1, options.GraphDegree);
-  field.Normals.assign(static_cast<size_t>(3 * n), 0.0);
-  field.Radii.assign(static_cast<size_t>(n), 0.0);
-  field.NeighborDistance.assign(static_cast<size_t>(n), 0.0);
-  field.Residual.assign(static_cast<size_t>(n), 0.0);
-  field.Outlier.assign(static_cast<size_t>(n), 0);
+  // On huge pages where the arrays are fresh (Common/LargeArrays.h: their pages' first touch was a large part of the
+  // time at 100k points).
+  detail::AssignLarge(field.Normals, static_cast<size_t>(3 * n), 0.0);
+  detail::AssignLarge(field.Radii, static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(field.NeighborDistance, static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(field.Residual, static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(field.Outlier, static_cast<size_t>(n), static_cast<unsigned char>(0));
   field.OutlierCount = 0;
-  field.SurfaceVariation.assign(static_cast<size_t>(n), 0.0);
-  field.MeanCurvature.assign(options.MeanCurvature ? static_cast<size_t>(n) : 0, 0.0);
-  field.Valid.assign(static_cast<size_t>(n), 0);
-  field.Graph.assign(static_cast<size_t>(n * degree), -1);
+  detail::AssignLarge(field.SurfaceVariation, static_cast<size_t>(n), 0.0);
+  detail::AssignLarge(field.MeanCurvature, options.MeanCurvature ? static_cast<size_t>(n) : 0, 0.0);
+  detail::AssignLarge(field.Valid, static_cast<size_t>(n), static_cast<unsigned char>(0));
+  detail::AssignLarge(field.Graph, static_cast<size_t>(n * degree), std::int32_t(-1));
   field.GraphDegree = degree;
   field.Scale = CloudScale();
   field.InvalidCount = n;
@@ -1339,7 +1344,9 @@ bool EstimateNormals(
   }
   bool aborted = false;
   // Per sorted position: the jet's misfit and the point's height over it (the sharp features' pass below).
-  std::vector<double> rms(static_cast<size_t>(nv), 0.0), height(static_cast<size_t>(nv), 0.0);
+  std::vector<double> rms, height;
+  detail::AssignLarge(rms, static_cast<size_t>(nv), 0.0);
+  detail::AssignLarge(height, static_cast<size_t>(nv), 0.0);
   struct Buffers
   {
     std::vector<Index> Ids, Local;
