@@ -194,19 +194,25 @@ def main():
                 if result.returncode != 0 or not rows:
                     sys.exit(f"{' '.join(command)} failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}")
                 stages = rows[0]["stages"]
+                halos = [r.get("halo") or {} for r in rows]
+                attempts = max((h.get("HaloAttempts") or 0) for h in halos)
+                radius, needed = halos[0].get("HaloRadius"), halos[0].get("HaloNeeded")
+                halo = ("-" if not attempts else
+                        f"{radius:.3g} ({needed:.3g}), {attempts:.0f} attempt(s)" if needed is not None else
+                        f"{radius:.3g}, {attempts:.0f} attempt(s)")
                 where = ", ".join(f"{k[:-7].lower()} {v:.1f}" for k, v in stages.items() if v is not None)
                 table.append((points, case, ranks, threads, max(r["seconds"] for r in rows),
                               max(r["rss_mb"] for r in rows), max(r["growth_mb"] for r in rows),
                               max(r["owned"] for r in rows), max(r["held"] for r in rows),
-                              sum(r["output"] for r in rows), where or "-"))
+                              sum(r["output"] for r in rows), where or "-", halo))
                 print(table[-1], file=sys.stderr, flush=True)
     print("| points | filter | ranks x threads | time (s, slowest rank) | where the time went (s, rank 0) | peak "
           "memory per rank (MB) | growth during the filter per rank (MB) | points owned per rank | points held per "
-          "rank | held / owned | output points (all ranks) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
-    for points, case, ranks, threads, seconds, rss, growth, owned, held, output, where in table:
+          "rank | held / owned | output points (all ranks) | halo radius (needed), attempts (most on a rank) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for points, case, ranks, threads, seconds, rss, growth, owned, held, output, where, halo in table:
         print(f"| {points:,} | {case} | {ranks} x {threads} | {seconds:.1f} | {where} | {rss:.0f} | {growth:.0f} | "
-              f"{owned:,} | {held:,.0f} | {held / max(owned, 1):.2f} | {output:,} |")
+              f"{owned:,} | {held:,.0f} | {held / max(owned, 1):.2f} | {output:,} | {halo} |")
     print("\n(per rank: the largest over the ranks; memory growth is the algorithm's, peak includes pvbatch and "
           "the cloud)")
 

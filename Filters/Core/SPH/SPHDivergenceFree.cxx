@@ -208,13 +208,18 @@ using GradientPair = SPHGradientPair;
 // sum_j v_j . G_ij (RowRate). They are bound by the additions' latency and the instruction count, not by memory:
 // each component is summed in two interleaved partial sums (the row's even and odd entries) added at the end, two
 // components at a time with SSE2 where it is there; the scalar code does the same operations in the same order.
+#if defined(__SSE2__)
+/// A pair's G_x, G_y widened to two doubles.
+inline __m128d GradientXY(const GradientPair& p)
+{
+  return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p.Gradient))));
+}
+#endif
+
 inline void RowImpulse(const GradientPair* pair, Index begin, Index end, const double* w, double out[3])
 {
   Index s = begin;
 #if defined(__SSE2__)
-  auto gradientXY = [](const GradientPair& p) {
-    return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p.Gradient))));
-  };
   __m128d xy0 = _mm_setzero_pd(), xy1 = _mm_setzero_pd();
   double z0 = 0.0, z1 = 0.0;
   for (; s + 1 < end; s += 2)
@@ -222,15 +227,15 @@ inline void RowImpulse(const GradientPair* pair, Index begin, Index end, const d
     const GradientPair& a = pair[s];
     const GradientPair& b = pair[s + 1];
     const double wa = w[a.Neighbor], wb = w[b.Neighbor];
-    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_set1_pd(wa), gradientXY(a)));
+    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_set1_pd(wa), GradientXY(a)));
     z0 += wa * static_cast<double>(a.Gradient[2]);
-    xy1 = _mm_add_pd(xy1, _mm_mul_pd(_mm_set1_pd(wb), gradientXY(b)));
+    xy1 = _mm_add_pd(xy1, _mm_mul_pd(_mm_set1_pd(wb), GradientXY(b)));
     z1 += wb * static_cast<double>(b.Gradient[2]);
   }
   if (s < end)
   {
     const double wa = w[pair[s].Neighbor];
-    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_set1_pd(wa), gradientXY(pair[s])));
+    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_set1_pd(wa), GradientXY(pair[s])));
     z0 += wa * static_cast<double>(pair[s].Gradient[2]);
   }
   alignas(16) double xy[2];
@@ -268,9 +273,6 @@ inline double RowRate(const GradientPair* pair, Index begin, Index end, const do
 {
   Index s = begin;
 #if defined(__SSE2__)
-  auto gradientXY = [](const GradientPair& p) {
-    return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p.Gradient))));
-  };
   __m128d xy0 = _mm_setzero_pd(), xy1 = _mm_setzero_pd();
   double z0 = 0.0, z1 = 0.0;
   for (; s + 1 < end; s += 2)
@@ -279,15 +281,15 @@ inline double RowRate(const GradientPair* pair, Index begin, Index end, const do
     const GradientPair& b = pair[s + 1];
     const double* va = v + 3 * static_cast<Index>(a.Neighbor);
     const double* vb = v + 3 * static_cast<Index>(b.Neighbor);
-    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_loadu_pd(va), gradientXY(a)));
+    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_loadu_pd(va), GradientXY(a)));
     z0 += va[2] * static_cast<double>(a.Gradient[2]);
-    xy1 = _mm_add_pd(xy1, _mm_mul_pd(_mm_loadu_pd(vb), gradientXY(b)));
+    xy1 = _mm_add_pd(xy1, _mm_mul_pd(_mm_loadu_pd(vb), GradientXY(b)));
     z1 += vb[2] * static_cast<double>(b.Gradient[2]);
   }
   if (s < end)
   {
     const double* va = v + 3 * static_cast<Index>(pair[s].Neighbor);
-    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_loadu_pd(va), gradientXY(pair[s])));
+    xy0 = _mm_add_pd(xy0, _mm_mul_pd(_mm_loadu_pd(va), GradientXY(pair[s])));
     z0 += va[2] * static_cast<double>(pair[s].Gradient[2]);
   }
   alignas(16) double xy[2];
