@@ -34,6 +34,25 @@ counter records them (it stops at the first step past stopAt). Both use the same
 MESHFREE_NUM_THREADS, default: all CPUs; SPlisHSPlasH runs OpenMP, MeshFree oneTBB). The 1-minute load average is
 read before and after each run and reported beside it.
 
+SPHERIC Test 2 (--scene spheric2 --dx DX): the Test 2 scene of Data/Scripts/spheric_test2.py (bench_spheric2.py)
+in the same two codes, 1 s (--time) from the initial state:
+  * MeshFree: SPH Fluid With Obstacles from pvpython (spheric_test2.make_scene(): the 3.22 x 1 x 1 m tank, the
+    column on the tank's lattice, round(1.228 / dx) x round(1 / dx) x round(0.55 / dx) particles at the far wall,
+    the 0.161 x 0.403 x 0.161 m box as the Obstacles surface), each solver in its own pvpython process (this script
+    under pvpython, --meshfree-spheric2), the proxy's defaults otherwise: Viscosity 1e-3 Pa s as the bench,
+    CFLNumber 0.25, TimeStep 2 ms (the proxy's default step cap), DFSPH tolerances 0.01 % / 0.1 %, at most 100
+    iterations; OutputInterval = the end time (one output: no landing steps on output times). Timed: the request
+    of the end time after the initial state's (set-up, boundary dummies and the first output excluded), wall and
+    CPU (the process' threads) seconds; steps from StepsTaken, iterations per step from the output's field data;
+  * SPlisHSPlasH: the same column on the same lattice (particles at (i + 1/2) dx from the block's start, as
+    MeshFree's: the block widened by half a spacing on each side, as for the dam break), the tank a static wall box
+    (UnitBox.obj scaled, faces half a spacing outside the tank, as above), the box a static (non-wall) rigid body
+    from an OBJ this script writes (its 12 triangles, outward normals, the specification's faces), the same step
+    rule (cflFactor 0.5, cflMethod 1: 0.2 dx / v_max, at most cflMaxTimeStepSize = 2 ms, MeshFree's TimeStep),
+    the same DFSPH tolerances, density 1000, kinematic viscosity 1e-6 m^2/s;
+  * the particle counts of both are reported (fluid; SPlisHSPlasH's boundary particles with Akinci walls).
+  What differs is as for the dam break (kernels, wall model, precision, MeshFree's stricter density stop).
+
 Set-up (once; nothing is downloaded, the five git directories are local copies, e.g. from a mirror):
   Testing/Benchmarks/setup_splishsplash.sh --sph SPlisHSPlasH.git --compactnsearch CompactNSearch.git \
       --discregrid Discregrid.git --genericparameters GenericParameters.git --pbd PositionBasedDynamics.git \
@@ -41,12 +60,17 @@ Set-up (once; nothing is downloaded, the five git directories are local copies, 
 Run (from the repository root, after building BenchSPH):
   /usr/bin/python3 Testing/Benchmarks/bench_splishsplash.py --simulator PATH/TO/SPHSimulator --time 1.0 \\
       --out Testing/Benchmarks/results
+  MESHFREE_PLUGIN=build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so /usr/bin/python3 \\
+      Testing/Benchmarks/bench_splishsplash.py --simulator PATH/TO/SPHSimulator --scene spheric2 --dx 0.02 \\
+      --time 1.0 --boundary volume-maps --out Testing/Benchmarks/results
 Writes OUT/splishsplash.md (the table, appended as a new section) and OUT/splishsplash.json (all runs, appended).
 """
 import argparse
 import json
+import math
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -129,6 +153,142 @@ def scene(size, end, boundary, box_obj):
     }
 
 
+# SPHERIC Test 2 (Data/Scripts/spheric_test2.py's TANK, WATER, BOX; repeated here so that this script needs no
+# ParaView when it only drives the runs; --meshfree-spheric2 checks them against spheric_test2's).
+T2_TANK = (0.0, 3.22, 0.0, 1.0, 0.0, 1.0)
+T2_WATER = (1.992, 3.22, 0.0, 1.0, 0.0, 0.55)
+T2_BOX = (0.6635, 0.8245, 0.2955, 0.6985, 0.0, 0.161)
+T2_TIME_STEP = 0.002  # SPH Fluid's TimeStep default (Plugin/xml/SPHFluid.xml), which spheric_test2 keeps
+
+
+def t2_column(dx):
+    """The layers (nx, ny, nz) and the lower corner of the column SPH Fluid builds in spheric_test2.make_scene():
+    FluidBounds [3.22 - round(1.228 / dx) dx, 3.22] x [0, 1] x [0, 0.55], floor(extent / dx + 0.5) nodes per axis
+    at lo + (i + 1/2) dx (SPHSetup.cxx)."""
+    length = round((T2_WATER[1] - T2_WATER[0]) / dx) * dx
+    lo = (T2_TANK[1] - length, T2_WATER[2], T2_WATER[4])
+    ext = (length, T2_WATER[3] - T2_WATER[2], T2_WATER[5] - T2_WATER[4])
+    return tuple(int(math.floor(e / dx + 0.5)) for e in ext), lo
+
+
+def write_box_obj(path, box):
+    """The box as a closed triangle mesh (12 triangles, counter-clockwise seen from outside: outward normals)."""
+    x0, x1, y0, y1, z0, z1 = box
+    v = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0), (x0, y0, z1), (x1, y0, z1), (x1, y1, z1),
+         (x0, y1, z1)]
+    quads = [(1, 4, 3, 2), (5, 6, 7, 8), (1, 2, 6, 5), (3, 4, 8, 7), (1, 5, 8, 4), (2, 3, 7, 6)]
+    with open(path, "w") as f:
+        f.write("# SPHERIC Test 2 box (bench_splishsplash.py)\n")
+        for p in v:
+            f.write("v %r %r %r\n" % p)
+        for a, b, c, d in quads:
+            f.write("f %d %d %d\nf %d %d %d\n" % (a, b, c, a, c, d))
+
+
+def scene_spheric2(dx, end, boundary, unit_box, box_obj):
+    """Test 2 in SPlisHSPlasH's JSON format (see the module docstring)."""
+    (nx, ny, nz), lo = t2_column(dx)
+    half = 0.5 * dx
+    tank = tuple(T2_TANK[2 * a + 1] - T2_TANK[2 * a] + dx for a in range(3))
+    centre = tuple(0.5 * (T2_TANK[2 * a] + T2_TANK[2 * a + 1]) for a in range(3))
+    box = tuple(T2_BOX[2 * a + 1] - T2_BOX[2 * a] for a in range(3))
+    config = scene(65536, end, boundary, unit_box)["Configuration"]
+    config.update(particleRadius=half, timeStepSize=T2_TIME_STEP, cflMaxTimeStepSize=T2_TIME_STEP)
+    return {
+        "Configuration": config,
+        "Materials": scene(65536, end, boundary, unit_box)["Materials"],
+        "RigidBodies": [
+            {
+                "geometryFile": unit_box,
+                "translation": list(centre),
+                "rotationAxis": [1, 0, 0],
+                "rotationAngle": 0,
+                "scale": list(tank),
+                "isDynamic": False,
+                "isWall": True,
+                "mapInvert": True,
+                "mapThickness": 0.0,
+                "mapResolution": [int(round(t / (2.0 * dx))) for t in tank],  # a cell per support radius
+                "samplingMode": 1,
+            },
+            {
+                "geometryFile": box_obj,  # already in place: no translation, unit scale
+                "translation": [0.0, 0.0, 0.0],
+                "rotationAxis": [1, 0, 0],
+                "rotationAngle": 0,
+                "scale": [1.0, 1.0, 1.0],
+                "isDynamic": False,
+                "isWall": False,
+                "mapInvert": False,
+                "mapThickness": 0.0,
+                "mapResolution": [max(8, int(math.ceil(b / half))) for b in box],  # a cell per half spacing
+                "samplingMode": 1,
+            },
+        ],
+        "FluidBlocks": [
+            {
+                "denseMode": 0,
+                "start": [lo[0] - half, lo[1] - half, lo[2] - half],
+                "end": [lo[0] + nx * dx + half, lo[1] + ny * dx + half, lo[2] + nz * dx + half],
+                "translation": [0.0, 0.0, 0.0],
+                "scale": [1, 1, 1],
+            }
+        ],
+    }
+
+
+def meshfree_spheric2_child(solver, dx, end):
+    """Run under pvpython: one Test 2 run of SPH Fluid With Obstacles, its measurements as one JSON line."""
+    sys.path.insert(0, os.path.join(ROOT, "Data", "Scripts"))
+    import spheric_test2
+    from paraview import servermanager as sm
+    from vtkmodules.numpy_interface import dataset_adapter as dsa
+    assert (tuple(spheric_test2.TANK), tuple(spheric_test2.WATER), tuple(spheric_test2.BOX)) == \
+        (T2_TANK, T2_WATER, T2_BOX), "bench_splishsplash.py's Test 2 geometry differs from spheric_test2.py's"
+    ns = {}
+    spheric_test2.load_plugin(ns)
+    fluid = spheric_test2.make_scene(ns, dx, end, end, solver)  # one output interval: the whole run
+    fluid.UpdatePipelineInformation()
+    assert abs(fluid.GetPropertyValue("TimeStep") - T2_TIME_STEP) < 1e-12, "TimeStep default is not 2 ms"
+    settings = {k: fluid.GetPropertyValue(k) for k in ("CFLNumber", "TimeStep", "DensityTolerance",
+                                                       "DivergenceTolerance", "MaximumIterations", "Viscosity",
+                                                       "ArtificialViscosity")}
+    fluid.UpdatePipeline(0.0)  # set-up and the initial state, not timed
+    first = dsa.WrapDataObject(sm.Fetch(fluid))
+    fluid.UpdatePropertyInformation()
+    steps0 = fluid.GetProperty("StepsTaken").GetElement(0)
+    t0, c0 = time.perf_counter(), time.process_time()
+    fluid.UpdatePipeline(end)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    out = dsa.WrapDataObject(sm.Fetch(fluid))
+    fluid.UpdatePropertyInformation()
+    row = dict(particles=first.GetNumberOfPoints(), particles_end=out.GetNumberOfPoints(),
+               steps=fluid.GetProperty("StepsTaken").GetElement(0) - steps0, sim_s=end, wall_s=wall, cpu_s=cpu,
+               settings=settings)
+    if solver == "DFSPH":
+        its = []
+        for name in ("DensityIterations", "DivergenceIterations"):
+            a = out.FieldData[name] if name in out.FieldData.keys() else None
+            its.append(float(a[1]) if a is not None and len(a) > 1 else float("nan"))
+        row["iterations"] = "%.2f / %.2f" % tuple(its)
+    print("RESULT " + json.dumps(row), flush=True)
+
+
+def run_meshfree_spheric2(pvpython, solver, dx, end, env):
+    cmd = [pvpython, "--no-mpi", os.path.abspath(__file__), "--meshfree-spheric2", solver, "--dx", repr(dx),
+           "--time", repr(end)]
+    rc, out, wall, l0, l1 = run(cmd, env=env)
+    row = dict(code="MeshFree " + solver, rc=rc, process_wall_s=wall, load_before=l0, load_after=l1,
+               command="pvpython --no-mpi Testing/Benchmarks/bench_splishsplash.py --meshfree-spheric2 %s --dx %r "
+               "--time %r" % (solver, dx, end))
+    for line in out.splitlines():
+        if line.startswith("RESULT "):
+            row.update(json.loads(line[len("RESULT "):]))
+    if "wall_s" not in row:
+        row["error"] = out[-3000:]
+    return row
+
+
 def load1():
     return os.getloadavg()[0]
 
@@ -160,21 +320,35 @@ def run_meshfree(bench, solver, size, end, env):
     return row
 
 
-def run_splishsplash(simulator, size, end, boundary, env, work):
+def run_splishsplash(simulator, size, end, boundary, env, work, dx=None):
+    """SPlisHSPlasH's DFSPH on BenchSPH's dam break at `size` particles, or on Test 2 at spacing `dx` (not None)."""
     models = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(simulator))), "data", "models")
     box = os.path.join(models, "UnitBox.obj")
     if not os.path.exists(box):
         return dict(code="SPlisHSPlasH DFSPH", rc=-1, error="no %s (SPlisHSPlasH's data/models)" % box)
-    path = os.path.join(work, "dambreak_%d.json" % size)
+    if dx is None:
+        name = "dambreak_%d.json" % size
+        content, recorded = scene(size, end, boundary, box), scene(size, end, boundary, "UnitBox.obj")
+    else:
+        name = "spheric2_dx%g.json" % dx
+        obj = os.path.join(work, "spheric2_box.obj")
+        write_box_obj(obj, T2_BOX)
+        content = scene_spheric2(dx, end, boundary, box, obj)
+        recorded = scene_spheric2(dx, end, boundary, "UnitBox.obj", "spheric2_box.obj")
+    path = os.path.join(work, name)
     with open(path, "w") as f:
-        json.dump(scene(size, end, boundary, box), f, indent=1)
+        json.dump(content, f, indent=1)
     outdir = os.path.join(work, "output")
     cmd = [simulator, "--no-gui", "--no-cache", "--no-initial-pause", "--output-dir", outdir, "--stopAt", repr(end),
            path]
+    # CPU seconds of the child (all its threads), from the children's resource usage before and after.
+    cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     rc, out, wall, l0, l1 = run(cmd, env=env, cwd=work)
+    cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     row = dict(code="SPlisHSPlasH DFSPH (%s)" % boundary, rc=rc, process_wall_s=wall, load_before=l0,
                load_after=l1, command="SPHSimulator --no-gui --no-cache --no-initial-pause --output-dir OUT "
-               "--stopAt %r dambreak_%d.json" % (end, size), scene=scene(size, end, boundary, "UnitBox.obj"))
+               "--stopAt %r %s" % (end, name), scene=recorded,
+               process_cpu_s=(cpu1.ru_utime + cpu1.ru_stime) - (cpu0.ru_utime + cpu0.ru_stime))
 
     def grab(pattern, cast=float):
         m = re.search(pattern, out)
@@ -201,8 +375,13 @@ def run_splishsplash(simulator, size, end, boundary, env, work):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--simulator", required=True, help="SPlisHSPlasH's SPHSimulator (setup_splishsplash.sh)")
+    ap.add_argument("--simulator", help="SPlisHSPlasH's SPHSimulator (setup_splishsplash.sh)")
+    ap.add_argument("--scene", choices=("dambreak", "spheric2"), default="dambreak",
+                    help="BenchSPH's dam break (default) or SPHERIC Test 2 at --dx")
+    ap.add_argument("--dx", type=float, default=0.04, help="Test 2 particle spacing, m (--scene spheric2)")
     ap.add_argument("--bench-sph", default=os.path.join(ROOT, "build", "bin", "BenchSPH"))
+    ap.add_argument("--pvpython", default=shutil.which("pvpython") or "pvpython",
+                    help="pvpython for the Test 2 runs of MeshFree (plugin from $MESHFREE_PLUGIN)")
     ap.add_argument("--size", type=int, default=65536, choices=sorted(BLOCKS))
     ap.add_argument("--time", type=float, default=1.0, help="simulated seconds (default 1)")
     ap.add_argument("--boundary", choices=("akinci", "volume-maps"), action="append",
@@ -211,11 +390,24 @@ def main():
     ap.add_argument("--threads", type=int, default=0, help="OMP_NUM_THREADS for all runs (default: all CPUs)")
     ap.add_argument("--out", default=None, help="folder for splishsplash.md / .json (default: print only)")
     ap.add_argument("--label", default="", help="a note for the results section")
+    ap.add_argument("--omp-wait-policy", choices=("default", "passive", "active"), action="append",
+                    help="OMP_WAIT_POLICY for SPlisHSPlasH's runs, one run per value given (default: unset, its "
+                         "own default: libgomp's threads spin at a barrier before they sleep, which a shared, "
+                         "loaded machine penalises; MeshFree's oneTBB threads yield)")
+    ap.add_argument("--meshfree-spheric2", choices=("WCSPH", "DFSPH"), default=None, help=argparse.SUPPRESS)
     a = ap.parse_args()
+    if a.meshfree_spheric2:  # the child run under pvpython
+        meshfree_spheric2_child(a.meshfree_spheric2, a.dx, a.time)
+        return 0
+    t2 = a.scene == "spheric2"
     boundaries = a.boundary or ["akinci"]
-    for exe in (a.simulator, a.bench_sph):
+    if not a.simulator:
+        sys.exit("bench_splishsplash.py: --simulator is required")
+    for exe in (a.simulator,) + ((shutil.which(a.pvpython) or a.pvpython,) if t2 else (a.bench_sph,)):
         if not (os.path.isfile(exe) and os.access(exe, os.X_OK)):
             sys.exit("bench_splishsplash.py: %s is not an executable" % exe)
+    if t2 and not os.path.exists(os.environ.get("MESHFREE_PLUGIN", "")):
+        sys.exit("bench_splishsplash.py: set MESHFREE_PLUGIN to build/lib/paraview-5.11/plugins/MeshFree/MeshFree.so")
     env = dict(os.environ)
     threads = a.threads or os.cpu_count()
     env["OMP_NUM_THREADS"] = str(threads)
@@ -227,44 +419,65 @@ def main():
     work = tempfile.mkdtemp(prefix="bench_splishsplash_")
     try:
         for solver in [s for s in a.solvers.split(",") if s]:
-            rows.append(run_meshfree(a.bench_sph, solver, a.size, a.time, env))
+            if t2:
+                rows.append(run_meshfree_spheric2(a.pvpython, solver.upper(), a.dx, a.time, env))
+            else:
+                rows.append(run_meshfree(a.bench_sph, solver, a.size, a.time, env))
             print(json.dumps(rows[-1]), flush=True)
         for boundary in boundaries:
-            rows.append(run_splishsplash(a.simulator, a.size, a.time, boundary, env, work))
-            print(json.dumps({k: v for k, v in rows[-1].items() if k != "scene"}), flush=True)
+            for policy in a.omp_wait_policy or ["default"]:
+                splish_env = dict(env)
+                if policy != "default":
+                    splish_env["OMP_WAIT_POLICY"] = policy.upper()
+                rows.append(run_splishsplash(a.simulator, a.size, a.time, boundary, splish_env, work,
+                                             a.dx if t2 else None))
+                if policy != "default":
+                    rows[-1]["code"] = rows[-1]["code"][:-1] + ", OMP_WAIT_POLICY=%s)" % policy.upper()
+                print(json.dumps({k: v for k, v in rows[-1].items() if k != "scene"}), flush=True)
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    head = "| code | particles | steps | simulated s | wall s | wall s / sim s | sim s / wall s | " \
-           "iterations/step (density / divergence) | load 1-min before / after |"
-    lines = [head, "|" + "---|" * 9]
+    head = "| code | particles (fluid + boundary) | steps | simulated s | wall s | CPU s | wall s / sim s | " \
+           "sim s / wall s | iterations/step (density / divergence) | load 1-min before / after |"
+    lines = [head, "|" + "---|" * 10]
     for r in rows:
         if r.get("wall_s") and r.get("sim_s"):
-            lines.append("| %s | %s | %s | %.4f | %.1f | %.1f | %.5f | %s | %.2f / %.2f |" % (
-                r["code"], r.get("particles"), r.get("steps"), r["sim_s"], r["wall_s"], r["wall_s"] / r["sim_s"],
+            cpu = r.get("cpu_s")
+            if cpu is None and r.get("process_cpu_s") is not None:
+                cpu_text = "(%.0f)" % r["process_cpu_s"]  # the whole process, loading included
+            else:
+                cpu_text = "%.1f" % cpu if cpu is not None else "-"
+            parts = "%s" % r.get("particles")
+            if r.get("boundary_particles"):
+                parts += " + %d" % r["boundary_particles"]
+            lines.append("| %s | %s | %s | %.4f | %.1f | %s | %.1f | %.5f | %s | %.2f / %.2f |" % (
+                r["code"], parts, r.get("steps"), r["sim_s"], r["wall_s"], cpu_text, r["wall_s"] / r["sim_s"],
                 r["sim_s"] / r["wall_s"], r.get("iterations", "-"), r["load_before"], r["load_after"]))
         else:
-            lines.append("| %s | failed (rc %s): see the JSON | | | | | | | |" % (r["code"], r.get("rc")))
+            lines.append("| %s | failed (rc %s): see the JSON | | | | | | | | |" % (r["code"], r.get("rc")))
     table = "\n".join(lines)
     print(table)
     if a.out:
         os.makedirs(a.out, exist_ok=True)
         with open(os.path.join(a.out, "splishsplash.md"), "a") as f:
-            f.write("\n## %s, %d particles, %g s simulated, %d threads%s\n\n" % (
-                stamp, a.size, a.time, threads, (": " + a.label) if a.label else ""))
+            what = ("SPHERIC Test 2 at dx = %g m" % a.dx) if t2 else ("%d particles" % a.size)
+            f.write("\n## %s, %s, %g s simulated, %d threads%s\n\n" % (
+                stamp, what, a.time, threads, (": " + a.label) if a.label else ""))
             f.write("Command: `/usr/bin/python3 Testing/Benchmarks/bench_splishsplash.py --simulator SPHSimulator "
-                    "--size %d --time %g%s`\n\n" % (a.size, a.time,
-                                                    "".join(" --boundary " + b for b in boundaries)))
+                    "%s--time %g --solvers %s%s%s`\n\n" % (
+                        ("--scene spheric2 --dx %g " % a.dx) if t2 else ("--size %d " % a.size), a.time, a.solvers,
+                        "".join(" --boundary " + b for b in boundaries),
+                        "".join(" --omp-wait-policy " + w for w in a.omp_wait_policy or [])))
             f.write(table + "\n")
         jpath = os.path.join(a.out, "splishsplash.json")
         old = []
         if os.path.exists(jpath):
             with open(jpath) as f:
                 old = json.load(f)
-        old.append(dict(stamp=stamp, size=a.size, time=a.time, threads=threads, label=a.label, runs=rows))
+        old.append(dict(stamp=stamp, scene=a.scene, dx=a.dx if t2 else None, size=None if t2 else a.size,
+                        time=a.time, threads=threads, label=a.label, runs=rows))
         with open(jpath, "w") as f:
             json.dump(old, f, indent=1)
     return 0 if all(r.get("wall_s") for r in rows) else 1
-
 
 if __name__ == "__main__":
     sys.exit(main())
