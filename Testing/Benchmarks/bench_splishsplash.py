@@ -87,6 +87,29 @@ DFSPH_SETTINGS = {"minIterations": 2, "maxIterations": 100, "maxError": 0.01, "m
                   "enableDivergenceSolver": True}
 
 
+def static_body(geometry, translation, scale, wall, resolution):
+    """A static boundary body of a SPlisHSPlasH scene: `wall` True for a container (its inside is the fluid's side,
+    the volume map inverted), False for an obstacle; `resolution` the volume map's cells per axis."""
+    return {
+        "geometryFile": geometry,
+        "translation": list(translation),
+        "rotationAxis": [1, 0, 0],
+        "rotationAngle": 0,
+        "scale": list(scale),
+        "isDynamic": False,
+        "isWall": wall,
+        "mapInvert": wall,
+        "mapThickness": 0.0,
+        "mapResolution": list(resolution),
+        "samplingMode": 1,
+    }
+
+
+def tank_body(unit_box, centre, tank, dx):
+    """The tank: the unit box scaled to `tank` around `centre`, a volume-map cell per support radius (2 dx)."""
+    return static_body(unit_box, centre, tank, True, [int(round(t / (2.0 * dx))) for t in tank])
+
+
 def scene(size, end, boundary, box_obj):
     bx, by, bz = BLOCKS[size]
     half = 0.5 * DX
@@ -126,21 +149,7 @@ def scene(size, end, boundary, box_obj):
                 "Standard viscosity": {"viscosity": 1e-6},  # 2.16
             }
         ],
-        "RigidBodies": [
-            {
-                "geometryFile": box_obj,
-                "translation": list(centre),
-                "rotationAxis": [1, 0, 0],
-                "rotationAngle": 0,
-                "scale": list(tank),
-                "isDynamic": False,
-                "isWall": True,
-                "mapInvert": True,
-                "mapThickness": 0.0,
-                "mapResolution": [int(round(t / (2.0 * DX))) for t in tank],  # a cell per support radius
-                "samplingMode": 1,
-            }
-        ],
+        "RigidBodies": [tank_body(box_obj, centre, tank, DX)],
         "FluidBlocks": [
             {
                 "denseMode": 0,
@@ -192,38 +201,17 @@ def scene_spheric2(dx, end, boundary, unit_box, box_obj):
     tank = tuple(T2_TANK[2 * a + 1] - T2_TANK[2 * a] + dx for a in range(3))
     centre = tuple(0.5 * (T2_TANK[2 * a] + T2_TANK[2 * a + 1]) for a in range(3))
     box = tuple(T2_BOX[2 * a + 1] - T2_BOX[2 * a] for a in range(3))
-    config = scene(65536, end, boundary, unit_box)["Configuration"]
+    dam = scene(65536, end, boundary, unit_box)  # its configuration and materials, then Test 2's geometry
+    config = dam["Configuration"]
     config.update(particleRadius=half, timeStepSize=T2_TIME_STEP, cflMaxTimeStepSize=T2_TIME_STEP)
     return {
         "Configuration": config,
-        "Materials": scene(65536, end, boundary, unit_box)["Materials"],
+        "Materials": dam["Materials"],
         "RigidBodies": [
-            {
-                "geometryFile": unit_box,
-                "translation": list(centre),
-                "rotationAxis": [1, 0, 0],
-                "rotationAngle": 0,
-                "scale": list(tank),
-                "isDynamic": False,
-                "isWall": True,
-                "mapInvert": True,
-                "mapThickness": 0.0,
-                "mapResolution": [int(round(t / (2.0 * dx))) for t in tank],  # a cell per support radius
-                "samplingMode": 1,
-            },
-            {
-                "geometryFile": box_obj,  # already in place: no translation, unit scale
-                "translation": [0.0, 0.0, 0.0],
-                "rotationAxis": [1, 0, 0],
-                "rotationAngle": 0,
-                "scale": [1.0, 1.0, 1.0],
-                "isDynamic": False,
-                "isWall": False,
-                "mapInvert": False,
-                "mapThickness": 0.0,
-                "mapResolution": [max(8, int(math.ceil(b / half))) for b in box],  # a cell per half spacing
-                "samplingMode": 1,
-            },
+            tank_body(unit_box, centre, tank, dx),
+            # the box's mesh is already in place: no translation, unit scale; a map cell per half spacing
+            static_body(box_obj, (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), False,
+                        [max(8, int(math.ceil(b / half))) for b in box]),
         ],
         "FluidBlocks": [
             {
