@@ -183,7 +183,7 @@ void UpdateHalo(const Distribution* d, std::vector<unsigned char>& values)
   std::transform(wide.begin(), wide.end(), values.begin(), [](double v) { return static_cast<unsigned char>(v); });
 }
 
-void UpdateHaloRows(const Distribution* d, std::vector<std::int32_t>& rows, int width)
+void UpdateHaloRows(const Distribution* d, detail::Buffer<std::int32_t>& rows, int width)
 {
   if (!d || width <= 0)
   {
@@ -269,7 +269,7 @@ std::uint64_t CloudSample::Hash(const double x[3])
   return h;
 }
 
-void CloudSample::Select(const Distribution* d, const double* xyz, std::vector<Candidate>& candidates, Index count)
+void CloudSample::Select(const Distribution* d, const double* xyz, detail::Buffer<Candidate>& candidates, Index count)
 {
   // Ties of the hash (distinct positions) by the coordinates: a total order on positions.
   auto before = [xyz](const Candidate& a, const Candidate& b) {

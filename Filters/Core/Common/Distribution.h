@@ -101,7 +101,7 @@ void UpdateHalo(const Distribution* d, std::vector<double>& values, int componen
 void UpdateHalo(const Distribution* d, std::vector<unsigned char>& values);
 /// Rows of `width` local point indices per point (-1 pads, as neighbour graphs store them): the halo points' rows
 /// replaced by their owners', translated through Key() (an entry whose point is not in the local cloud: -1).
-void UpdateHaloRows(const Distribution* d, std::vector<std::int32_t>& rows, int width);
+void UpdateHaloRows(const Distribution* d, detail::Buffer<std::int32_t>& rows, int width);
 /// UpdateHalo for values kept in a grid's sorted order (one per sorted position s, of local point order[s]):
 /// each vector of `sorted` is one component; n is the number of local points.
 void UpdateHaloInOrder(const Distribution* d, const std::vector<Index>& order, Index n,
@@ -117,8 +117,8 @@ public:
   template <class Eligible>
   void Choose(const Distribution* d, const double* xyz, Index n, Index count, const Eligible& eligible)
   {
-    std::vector<Candidate> candidates;
-    detail::ReserveLarge(candidates, static_cast<std::size_t>(n > 0 ? n : 0)); // no regrowth, huge pages
+    detail::Buffer<Candidate> candidates;
+    detail::ReserveLarge(candidates, static_cast<std::size_t>(n > 0 ? n : 0)); // no regrowth, pooled or huge pages
     for (Index i = 0; i < n; ++i)
     {
       if (eligible(i))
@@ -142,7 +142,7 @@ private:
     Index Point;
   };
   static std::uint64_t Hash(const double x[3]);
-  void Select(const Distribution* d, const double* xyz, std::vector<Candidate>& candidates, Index count);
+  void Select(const Distribution* d, const double* xyz, detail::Buffer<Candidate>& candidates, Index count);
   std::vector<Index> Mine;
   std::vector<Index> Rank; // per local sample point: its place in the whole sample
   Index Total = 0;

@@ -69,41 +69,6 @@ namespace meshfree
 {
 using Index = std::int64_t;
 
-namespace detail
-{
-/// Allocator whose resize() leaves trivial elements uninitialised (the build writes them in parallel), large
-/// blocks on huge pages (LargeArrays.h: their first touch is a fraction of the cost).
-template <class T>
-struct UninitializedAllocator : std::allocator<T>
-{
-  using value_type = T;
-  T* allocate(std::size_t n) { return static_cast<T*>(LargeAllocate(n * sizeof(T))); }
-  void deallocate(T* p, std::size_t n) noexcept { LargeFree(p, n * sizeof(T)); }
-  template <class U>
-  struct rebind
-  {
-    using other = UninitializedAllocator<U>;
-  };
-  UninitializedAllocator() = default;
-  template <class U>
-  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept
-  {
-  }
-  template <class U>
-  void construct(U* p) noexcept
-  {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args)
-  {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
-template <class T>
-using Buffer = std::vector<T, UninitializedAllocator<T>>;
-} // namespace detail
-
 class NeighborGrid
 {
 public:

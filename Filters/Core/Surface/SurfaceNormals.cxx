@@ -721,8 +721,8 @@ bool BuildThinnedClouds(const NeighborGrid& grid, int classes, std::vector<Neigh
       cell[a] = GridAxisCell(sorted[3 * s + a] - bounds[2 * a], inverse, dims[a]);
     }
   };
-  std::vector<std::vector<double>> xyz(static_cast<size_t>(classes));
-  for (std::vector<double>& c : xyz)
+  std::vector<detail::Buffer<double>> xyz(static_cast<size_t>(classes));
+  for (detail::Buffer<double>& c : xyz)
   {
     detail::ReserveLarge(c, static_cast<size_t>(3 * (nv / classes + 1)));
   }
@@ -746,7 +746,7 @@ bool BuildThinnedClouds(const NeighborGrid& grid, int classes, std::vector<Neigh
     const Index phase = (first[0] + 3 * first[1] + 7 * first[2]) % classes;
     for (Index j = begin; j <= s; ++j)
     {
-      std::vector<double>& c = xyz[static_cast<size_t>((j - begin + phase) % classes)];
+      detail::Buffer<double>& c = xyz[static_cast<size_t>((j - begin + phase) % classes)];
       c.insert(c.end(), sorted + 3 * j, sorted + 3 * j + 3);
     }
     begin = s + 1;
@@ -762,7 +762,7 @@ bool BuildThinnedClouds(const NeighborGrid& grid, int classes, std::vector<Neigh
       thin.clear();
       return false;
     }
-    std::vector<double>().swap(xyz[c]);
+    detail::Buffer<double>().swap(xyz[c]);
   }
   return true;
 }

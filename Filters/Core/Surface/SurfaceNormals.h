@@ -117,7 +117,7 @@ struct NormalField
   std::vector<double> Residual;         // distance from the point to its neighbours' jet (at max(r_k, Radius))
   std::vector<unsigned char> Outlier;   // residual > max(6 x median residual, 5 % of r_k): left out of fits
   std::vector<unsigned char> Valid;
-  std::vector<std::int32_t> Graph;      // GraphDegree nearest other points per point (-1 pads)
+  detail::Buffer<std::int32_t> Graph;   // GraphDegree nearest other points per point (-1 pads)
   int GraphDegree = 0;
   CloudScale Scale;
   Index InvalidCount = 0;        // over this process' own points (all when serial)

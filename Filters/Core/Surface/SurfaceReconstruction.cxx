@@ -481,7 +481,7 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
     // What the fits, the hole filling, the contour and the trimming no longer read goes now: the orientation's
     // graph, the radii and the normals' statistics (56 bytes per point; a distributed run's peak falls in the
     // contour, the serial one's in the orientation: issue 24).
-    std::vector<std::int32_t>().swap(normals.Graph);
+    detail::Buffer<std::int32_t>().swap(normals.Graph);
     std::vector<double>().swap(normals.Radii);
     std::vector<double>().swap(normals.SurfaceVariation);
     std::vector<double>().swap(normals.Residual);
