@@ -81,11 +81,17 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
       rank[order[s]] = static_cast<std::int32_t>(s);
     }
   });
-  // Per sorted position: the value signed along the oriented normal, and the neighbours that take part.
+  // Per sorted position: the value signed along the oriented normal, and the neighbours that take part (their
+  // number, the point included, in `count`). A row's unused entries point to the slot after the last position,
+  // which holds -0.0: x + (-0.0) is x for every x (-0.0 too), so that every row sums `degree` terms without a branch
+  // and the same bits as its neighbours alone.
+  const std::int32_t none = static_cast<std::int32_t>(nv);
   std::vector<double> k, next; // std::vector: UpdateHaloInOrder's
-  detail::AssignLarge(k, static_cast<size_t>(nv), 0.0);
-  detail::AssignLarge(next, static_cast<size_t>(nv), 0.0);
-  detail::Buffer<std::int32_t> graph(static_cast<size_t>(nv) * degree, -1);
+  detail::AssignLarge(k, static_cast<size_t>(nv) + 1, 0.0);
+  detail::AssignLarge(next, static_cast<size_t>(nv) + 1, 0.0);
+  k[nv] = next[nv] = -0.0;
+  detail::Buffer<std::int32_t> graph(static_cast<size_t>(nv) * degree, none);
+  detail::Buffer<std::int32_t> count(static_cast<size_t>(nv), 1);
   ParallelFor(nv, 4096, [&](Index b0, Index b1) {
     for (Index s = b0; s < b1; ++s)
     {
@@ -112,6 +118,7 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
           graph[static_cast<size_t>(s) * degree + kept++] = rank[v];
         }
       }
+      count[s] = 1 + kept;
     }
   });
   for (int round = 0; round < CurvatureRounds; ++round)
@@ -121,13 +128,11 @@ void SmoothJetCurvature(const NeighborGrid& grid, const NormalField& field, cons
       {
         const std::int32_t* row = &graph[static_cast<size_t>(s) * degree];
         double sum = k[s];
-        int count = 1;
-        for (int j = 0; j < degree && row[j] >= 0; ++j)
+        for (int j = 0; j < degree; ++j)
         {
           sum += k[row[j]];
-          ++count;
         }
-        next[s] = sum / count;
+        next[s] = sum / count[s];
       }
     });
     k.swap(next);
