@@ -21,10 +21,11 @@
  * Mid-size blocks (PoolFrom = 64 KiB up to LargeBytes) are kept when freed, up to PoolBytes (32 MiB) of them, the
  * oldest let go first, and given again to a later request they hold (at most twice its size): their pages are
  * mapped already, so a filter's scratch arrays, freed at the end of one stage or run, cost no faults in the next
- * (the mid-size arrays of a 100k-point cloud are too small for huge pages: at 100k points Meshless Normals faulted
- * about 6,400 pages a run, about 0.1 s of its 0.4 s; with the pool 2,500). glibc's malloc keeps up to 64 MiB of
- * freed memory at the top of its heap in the same way. detail::Buffer (a vector whose resize leaves trivial
- * elements uninitialised) allocates through LargeAllocate: the core's internal per-point arrays are Buffers.
+ * (the arrays of a 100k-point cloud are too small for huge pages: there Meshless Normals' core faulted about 6,400
+ * pages a run, 0.1 CPU s of 0.7-0.9, mostly in serial stages; with the pool 2,100, its std::vector arrays, and
+ * through the plugin, run again in pvpython, none instead of 5,400). glibc's malloc keeps up to 64 MiB of freed
+ * memory at the top of its heap in the same way. detail::Buffer (a vector whose resize leaves trivial
+ * elements uninitialised) allocates through LargeAllocate (the core's scratch arrays; public arrays stay std::vector).
  */
 #ifndef meshfree_LargeArrays_h
 #define meshfree_LargeArrays_h
