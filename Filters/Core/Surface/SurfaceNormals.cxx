@@ -308,6 +308,18 @@ void SpreadSubset(const Index* pos, size_t count, size_t used, Index* picked)
   }
 }
 
+/// SpreadSubset's entries: pos itself when all of them are used (the same list, without the copy), else the subset
+/// written to `subset`.
+const Index* Spread(const Index* pos, size_t count, size_t used, Index* subset)
+{
+  if (used == count)
+  {
+    return pos;
+  }
+  SpreadSubset(pos, count, used, subset);
+  return subset;
+}
+
 /// The sums of a jet's least squares (FitJet) in the frame (e1, e2, e3) = (t1, t2, n): over the points whose
 /// scaled offset d = (p - x) inv is not zero, with u = d.e1, v = d.e2, h = d.e3 and q = h^2 / 2, each summed in the
 /// points' order: U the monomials 1 u v uu uv vv uuu uuv uvv vvv uuuu uuuv uuvv uvvv vvvv (U[0] the count), H the
@@ -519,8 +531,8 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
     return out;
   }
   const size_t used = std::min(count, std::min(limit, MaxThinFit));
-  Index picked[MaxThinFit];
-  SpreadSubset(pos, count, used, picked);
+  Index subset[MaxThinFit];
+  const Index* picked = Spread(pos, count, used, subset);
   // The frame (PCA) from fewer points still: the jet corrects its tilt.
   const size_t framed = std::min(used, FramePoints);
   Index framePicked[FramePoints];
@@ -632,8 +644,8 @@ bool JetResidual(const double* sorted, const Index* pos, size_t count, const dou
     return false;
   }
   const size_t used = std::min(count, MaxFit);
-  Index picked[MaxFit];
-  SpreadSubset(pos, count, used, picked);
+  Index subset[MaxFit];
+  const Index* picked = Spread(pos, count, used, subset);
   const double inv = 1.0 / scale;
   // Tangent axes: any orthonormal pair completing the normal.
   const double e3[3] = { normal[0], normal[1], normal[2] };
