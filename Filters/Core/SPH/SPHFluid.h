@@ -201,6 +201,15 @@ struct SPHGradientPair
   std::int32_t Neighbor;
 };
 
+/// DFSPH's second pair stream, beside SPHGradientPair: what the non-pressure accelerations need of the pair besides
+/// G_ij = k (x_i - x_j) (SPHAcceleration::NonPressure): h - |r| (viscosity) and 1 / (k (|r|^2 + eps)) (artificial
+/// viscosity; 0 where k = 0), in single precision, 8 bytes.
+struct SPHPairShape
+{
+  float Viscous;
+  float Artificial;
+};
+
 class SPHFluid
 {
 public:
@@ -323,6 +332,9 @@ private:
   // rounding keeps G_ji = -G_ij exact). The wall pairs' coefficients m GradientNorm shape(r), and each particle's own
   // sum_f G + 2 sum_b G (3 per particle, the fluid part summed from the rounded G_ij).
   std::vector<SPHGradientPair> Pairs;
+  // The same pairs' SPHPairShape: the non-pressure pass reads the pair list instead of the positions (no distance,
+  // no square root, no kernel per pair); filled only when that pass uses it (no surface tension).
+  std::vector<SPHPairShape> PairShapes;
   std::vector<double> WallCoefficient, SelfGradient;
   std::vector<double> Alpha, Kappa, KappaOverRho, OldVelocity, Smoothed;
   // DFSPH: each particle's pressure impulse, sum over the steps of the current Advance() call of dt rho (kappa_density
