@@ -293,6 +293,11 @@ public:
   /// Largest stable step for the current state and CFL factor lambda (see the header comment).
   double StableTimeStep(const SPHState& state, double lambda) const;
 
+  /// The largest CFLNumber a solver uses (larger values are reduced to it, with a warning): WCSPH 0.4, the
+  /// leap-frog's stability limit; DFSPH 1, where its step 0.4 lambda h / v_max lets no particle move more than
+  /// 0.4 h (0.8 dx with h = 2 dx) a step (SPHDivergenceFree.cxx, step 2).
+  static double MaximumCFLNumber(SPHSolver solver) { return solver == SPHSolver::DFSPH ? 1.0 : 0.4; }
+
 private:
   /// The step of the state whose CFL maxima are `e` at `time` towards `targetTime`, `steps` already taken in
   /// this call (TimeStep, CFL, the stability reduction, the landing on targetTime); false with Error set when the
