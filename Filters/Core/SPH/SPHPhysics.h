@@ -285,7 +285,8 @@ struct SPHAcceleration
       // Approaching pairs only (v_ij . r < 0), without a branch: which pairs approach is close to random, and a
       // receding pair adds +-0, which leaves Ap as it is.
       const double vg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
-      const double pair = c.ArtificialFactor * fmax(-vg, 0.0) * artificial / (0.5 * (this->RhoI + rhoJ));
+      const double approach = vg < 0.0 ? -vg : 0.0; // a max, not fmax (a library call here)
+      const double pair = c.ArtificialFactor * approach * artificial / (0.5 * (this->RhoI + rhoJ));
       this->Ap[0] += pair * g[0];
       this->Ap[1] += pair * g[1];
       this->Ap[2] += pair * g[2];
