@@ -14,12 +14,13 @@
 //
 // With --box 1 (3D) the box is there: the whole Test 2 scene as Data/Scripts/spheric_test2.py builds it, through the
 // core alone (no VTK output, no probes: the solver's own cost, e.g. for a profile). --timestep sets the step cap
-// (TimeStep), --gas-stiffness WCSPH's c0^2, --front 0 leaves the front out (its neighbour search). Each line also gives the CPU seconds of the process so far and, for
-// DFSPH, the solves' iterations per step over the interval.
+// (TimeStep), --gas-stiffness WCSPH's c0^2, --density-tolerance DFSPH's, --front 0 leaves the front out (its neighbour
+// search). Each line also gives the CPU seconds of the process so far and, for DFSPH, the solves' iterations per
+// step over the interval.
 //
 // Usage: BenchSPHFront [--dim 2|3] [--dx 0.01] [--solver dfsph|wcsph] [--end 0.45] [--every 0.005]
 //                      [--artificial-viscosity A] [--smoothing-length H] [--cfl C] [--box 0|1] [--timestep T]
-//                      [--gas-stiffness K] [--front 0|1]
+//                      [--gas-stiffness K] [--density-tolerance T] [--front 0|1]
 #include "SPH/SPHFluid.h"
 
 #include <algorithm>
@@ -39,7 +40,7 @@ int Usage(const char* message)
   std::fprintf(stderr,
     "BenchSPHFront: %s\nusage: BenchSPHFront [--dim 2|3] [--dx 0.01] [--solver dfsph|wcsph] [--end 0.45] "
     "[--every 0.005] [--artificial-viscosity A] [--smoothing-length H] [--cfl C] [--box 0|1] [--timestep T] "
-    "[--gas-stiffness K] [--front 0|1]\n",
+    "[--gas-stiffness K] [--density-tolerance T] [--front 0|1]\n",
     message);
   return 2;
 }

@@ -19,8 +19,8 @@
 //     particle moves more than 0.4 h a step: SPHFluid::MaximumCFLNumber), at most TimeStep. The cap was WCSPH's
 //     leap-frog limit 0.4 until issue 25 measured larger steps on SPHERIC Test 2 (dx = 0.04 m, TimeStep 10 ms, one
 //     thread): CFLNumber 0.4 / 0.6 / 1 took 1,446 / 1,215 / 932 steps with 3.0 / 3.6 / 5.2 density iterations a
-//     step, 34 / 29 / 26 CPU s, H2 error 8.6 / 7.9 / 7.1 %, H4 2.6 / 2.5 / 2.5 %, no mass lost; 1.5 ran as 1 does
-//     (the 10 ms cap and the 10 ms outputs set the step);
+//     step, H2 error 8.6 / 7.9 / 7.1 %, H4 2.6 / 2.5 / 2.5 %, no mass lost, and CFLNumber 1 took 0.8 of the CPU
+//     time of 0.4 (results/spheric2.md); 1.5 ran as 1 does (the 10 ms cap and the 10 ms outputs set the step);
 //  3. divergence solve on v: find P >= 0 that makes Drho/Dt_i = 0 where P_i > 0 (and <= 0 where P_i = 0), until
 //     the average of max(Drho/Dt, 0) dt / rho0 is at most DivergenceTolerance (percent);
 //  4. the non-pressure accelerations (gravity, viscosity, artificial viscosity, surface tension: the WCSPH terms
@@ -47,9 +47,9 @@
 // expansion four). On SPHERIC Test 2 nearly every iteration is an expansion (some 100 of 10,850 particles of the
 // density solve reach P = 0 in each); restarting after each, as before (issue 25), made the solver a projected
 // steepest descent: 3,355 density iterations over the first 2.5 s at dx = 0.04 m with 10 ms steps, 2,038 with the
-// direction kept (BenchSPHFront --box 1 --cfl 1 --timestep 0.01, one thread: 13.5 against 11.1 CPU s). It replaces relaxed Jacobi iterations P <- max(P + 0.5 alpha e / s, 0)
-// (IISPH's relaxation; the papers' form), which remove the smooth part of an error about (L / h)^2 times more
-// slowly than its particle-scale part: on the 2D column they needed 300 iterations per step at 1e-4 % to rest.
+// direction kept (BenchSPHFront --box 1 --cfl 1 --timestep 0.01, one thread: 13.5 against 11.1 CPU s).
+// It replaces relaxed Jacobi iterations P <- max(P + 0.5 alpha e / s, 0) (IISPH's relaxation; the papers' form),
+// which remove the smooth part of an error about (L / h)^2 times more slowly than its particle-scale part: on the 2D column they needed 300 iterations per step at 1e-4 % to rest.
 // The projection matters: CG steps truncated at the first particle reaching P = 0 (Polyak's active set) made the
 // 2D dam-break front 30-45 % fast (particles at the free surface and the front, where many P are near 0, got few,
 // stale corrections); with the expansion step the front is closer to the experiment than with Jacobi on the
