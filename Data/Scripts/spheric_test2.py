@@ -134,6 +134,16 @@ def probes(out, dx):
     return row
 
 
+def output(fluid):
+    """The source's output at its last update: the algorithm's own object when it runs in this process (pvpython's
+    built-in session, the GUI without a server: no copy; Fetch cost 7.6 ms of CPU per output at dx = 0.04 m, as much
+    as a DFSPH step, against 1.9 ms for the probes themselves), else fetched from the server."""
+    connection = sm.ActiveConnection
+    if connection is not None and not connection.IsRemote():
+        return fluid.GetClientSideObject().GetOutputDataObject(0)
+    return sm.Fetch(fluid)
+
+
 def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True, properties=None):
     size = column_size(dx)
     spec = (WATER[1] - WATER[0], WATER[3] - WATER[2], WATER[5] - WATER[4])
@@ -149,7 +159,7 @@ def run(namespace, dx, end, interval, solver, out_csv, show=False, progress=True
     cpu_start = time.process_time()
     for t in times:
         fluid.UpdatePipeline(t)
-        out = dsa.WrapDataObject(sm.Fetch(fluid))
+        out = dsa.WrapDataObject(output(fluid))
         row = {"t": t}
         row.update(probes(out, dx))
         row["particles"] = out.GetNumberOfPoints()

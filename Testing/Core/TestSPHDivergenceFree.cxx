@@ -331,6 +331,31 @@ TEST(SPHDivergenceFree, HostileSettings)
     EXPECT_TRUE(SPHFluid::Statistics(s, fluid.ParticleMass()).Finite);
     EXPECT_TRUE(InsideDomain(s, p));
   }
+  { // a CFL number above DFSPH's limit of 1: a warning, and the steps of CFLNumber 1 (the same states); 1 itself,
+    // above WCSPH's 0.4, is accepted without one and takes longer steps than 0.4
+    SPHParameters p = SmallScene(2);
+    p.TimeStep = 1.0;
+    std::vector<SPHState> states;
+    for (double lambda : { 10.0, 1.0, 0.4 })
+    {
+      p.CFLNumber = lambda;
+      SPHFluid fluid;
+      fluid.Setup(p);
+      EXPECT_EQ(fluid.Warnings().empty(), lambda <= 1.0) << lambda;
+      if (lambda > 1.0 && !fluid.Warnings().empty())
+      {
+        EXPECT_NE(fluid.Warnings().front().find("CFLNumber"), std::string::npos);
+      }
+      SPHState s = fluid.InitialState();
+      ASSERT_EQ(fluid.Advance(s, 0.1), SPHFluid::Status::Ok) << fluid.ErrorMessage();
+      EXPECT_TRUE(SPHFluid::Statistics(s, fluid.ParticleMass()).Finite);
+      EXPECT_TRUE(InsideDomain(s, p));
+      states.push_back(s);
+    }
+    EXPECT_EQ(states[0].Position, states[1].Position);
+    EXPECT_EQ(states[0].Steps, states[1].Steps);
+    EXPECT_LT(states[1].Steps, states[2].Steps);
+  }
   { // one particle: it falls to the floor and stays in the container
     SPHParameters p = SmallScene(3);
     SetBox(p.FluidBounds, { 0.1, 0.11, 0.02, 0.03, 0.1, 0.11 });

@@ -15,8 +15,12 @@
 //     particle's own density rate to its own P, bounded below by a tenth of an interior particle's value (a
 //     particle wedged in a corner could otherwise be kicked at tens of m/s; 0 for a particle without neighbours);
 //  2. the step from the velocity alone: dt = lambda min(0.4 h / v_max, sqrt(h / |g|), 0.125 h^2 / nu), lambda =
-//     CFLNumber (0.25 by default: 0.2 dx / v_max with h = 2 dx, SPlisHSPlasH's default; capped at 0.4), at most
-//     TimeStep;
+//     CFLNumber (0.25 by default: 0.2 dx / v_max with h = 2 dx, SPlisHSPlasH's default; capped at 1, where no
+//     particle moves more than 0.4 h a step: SPHFluid::MaximumCFLNumber), at most TimeStep. The cap was WCSPH's
+//     leap-frog limit 0.4 until issue 25 measured larger steps on SPHERIC Test 2 (dx = 0.04 m, TimeStep 10 ms, one
+//     thread): CFLNumber 0.4 / 0.6 / 1 took 1,446 / 1,215 / 932 steps with 3.0 / 3.6 / 5.2 density iterations a
+//     step, H2 error 8.6 / 7.9 / 7.1 %, H4 2.6 / 2.5 / 2.5 %, no mass lost, and CFLNumber 1 took 0.8 of the CPU
+//     time of 0.4 (results/spheric2.md); 1.5 ran as 1 does (the 10 ms cap and the 10 ms outputs set the step);
 //  3. divergence solve on v: find P >= 0 that makes Drho/Dt_i = 0 where P_i > 0 (and <= 0 where P_i = 0), until
 //     the average of max(Drho/Dt, 0) dt / rho0 is at most DivergenceTolerance (percent);
 //  4. the non-pressure accelerations (gravity, viscosity, artificial viscosity, surface tension: the WCSPH terms
@@ -35,12 +39,17 @@
 // (1 / (s |sum_f G + 2 sum_b G|^2 + s sum_f |G|^2), i.e. DFSPH's factor alpha_i / (rho_i s)): CG steps on the free
 // set (P_i > 0 or e_i > 0); a step that would make some P negative is taken in full and projected on P >= 0, the
 // velocities changed by what P actually changed and the error recomputed (an "expansion step"), then the CG
-// restarts on the new free set; it also restarts when the particles held at P = 0 have more error left than the
-// free ones (the proportioning test of Dostal's MPRGP, Dostal & Schoberl 2005, with Gamma = 1; MPRGP takes the
-// expansion with a fixed step length). One iteration costs two neighbour passes (B d, then A d), as a Jacobi
-// iteration does (an expansion four). It replaces relaxed Jacobi iterations P <- max(P + 0.5 alpha e / s, 0)
-// (IISPH's relaxation; the papers' form), which remove the smooth part of an error about (L / h)^2 times more
-// slowly than its particle-scale part: on the 2D column they needed 300 iterations per step at 1e-4 % to rest.
+// goes on over the new free set with its direction kept there (zero off it); it restarts on z when that direction
+// does not descend, and when the particles held at P = 0 have more error left than the free ones (the
+// proportioning test of Dostal's MPRGP, Dostal & Schoberl 2005, with Gamma = 1; MPRGP takes the expansion with a
+// fixed step length). The step length is the exact line search (d . r) / (d . A d) (for a conjugate direction
+// d . r = r . z). One iteration costs two neighbour passes (B d, then A d), as a Jacobi iteration does (an
+// expansion four). On SPHERIC Test 2 nearly every iteration is an expansion (some 100 of 10,850 particles of the
+// density solve reach P = 0 in each); restarting after each, as before (issue 25), made the solver a projected
+// steepest descent: 3,355 density iterations over the first 2.5 s at dx = 0.04 m with 10 ms steps, 2,038 with the
+// direction kept (BenchSPHFront --box 1 --cfl 1 --timestep 0.01, one thread: 13.5 against 11.1 CPU s).
+// It replaces relaxed Jacobi iterations P <- max(P + 0.5 alpha e / s, 0) (IISPH's relaxation; the papers' form),
+// which remove the smooth part of an error about (L / h)^2 times more slowly than its particle-scale part: on the 2D column they needed 300 iterations per step at 1e-4 % to rest.
 // The projection matters: CG steps truncated at the first particle reaching P = 0 (Polyak's active set) made the
 // 2D dam-break front 30-45 % fast (particles at the free surface and the front, where many P are near 0, got few,
 // stale corrections); with the expansion step the front is closer to the experiment than with Jacobi on the
@@ -124,6 +133,12 @@
 // (RowImpulse, RowRate); d . A d and the step's limit are reduced in the A d pass, and the CG update of q, r, v in
 // the preconditioning pass. Same iterations as the double, single-accumulator passes on the benchmarks (the bits
 // differ); measured in results/spheric2.md, "Time to solution".
+// The non-pressure accelerations (step 4) read the pair list too, with a second stream of two floats a pair
+// (SPHPairShape: h - |r| for the viscosity, 1 / (k (r^2 + eps)) for the artificial viscosity, G_ij = k r), written
+// by the fields pass: no positions, distances, square roots or kernels per pair, and no branch on whether a pair
+// approaches; without surface tension the wall dummies are skipped there (they add nothing: their pressure is the
+// solves'). On SPHERIC Test 2 (dx = 0.04 m, perf, one thread) that pass went from 19 % of a step to 11 %, the
+// fields pass from 12 % to 15 %. With surface tension the pass sums over the positions as before.
 //
 // The hydrostatic column (TestSPHDivergenceFree; issue 25). Until a-d below were changed it never came to rest:
 // its particles kept rearranging at speeds of order sqrt(g dx) and its pressure's relative L2 error against rho0 g
@@ -196,7 +211,6 @@ namespace meshfree
 namespace
 {
 constexpr Index ParallelThreshold = 4096; // as in SPHFluid.cxx
-constexpr double StabilityLambda = 0.4;   // largest CFL factor (as WCSPH's)
 constexpr int MinimumIterations = 2;      // corrections per solve after a warm start, whatever the error
 constexpr double ResidualReduction = 0.3; // the density solve reduces its error's RMS to 0.3 of its start ...
 constexpr double ReductionFloor = 0.01;   // ... unless its average error is below 1 % of the tolerance
@@ -347,15 +361,18 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
   this->InverseDensity.resize(n);
   this->Alpha.resize(n);
   this->Pairs.resize(fs[n]);
+  const SPHConstants& c = this->Physics;
+  const bool shapes = !c.Tension; // the non-pressure pass reads the pair list (AdvanceDivergenceFree)
+  this->PairShapes.resize(shapes ? fs[n] : 0);
   this->WallCoefficient.resize(bs[n]);
   this->SelfGradient.resize(3 * n);
   this->GradientStrength.resize(n);
-  const SPHConstants& c = this->Physics;
   const double strengthScale = this->LatticeGradientStrength > 0.0 ? 1.0 / this->LatticeGradientStrength : 0.0;
   const SPHDensityConstants dc = SPHDensityConstantsOf(c);
   const double cutoff = 1e-9 * this->LatticeFactorSum;
   double* rho = state.Density.data();
   GradientPair* pair = this->Pairs.data();
+  SPHPairShape* shape = this->PairShapes.data();
   double* wall = this->WallCoefficient.data();
   double* self = this->SelfGradient.data();
   ParallelFor(
@@ -369,17 +386,22 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
         // and, in the same pass, m grad W_ij = -G_ij, G_ij = coefficient (x_i - x_j), coefficient = m GradientNorm
         // shape(r) >= 0.
         SPHDensitySum density(dc);
-        auto coefficient = [&](const double* xj, double* r) {
+        auto coefficient = [&](const double* xj, double* r, double& r2, double& distance) {
           for (int a = 0; a < 3; ++a)
           {
             r[a] = xi[a] - xj[a];
           }
-          const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+          r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
           density.Add(r2, dc);
           double k = 0.0;
-          if (r2 < c.H2 && r2 > 0.0)
+          distance = c.H;
+          if (r2 < c.H2)
           {
-            k = c.PressureFactor * SPHGradientShape(r2, std::sqrt(r2), c.H, c.H2, c.SpikyGradient);
+            distance = std::sqrt(r2);
+            if (r2 > 0.0)
+            {
+              k = c.PressureFactor * SPHGradientShape(r2, distance, c.H, c.H2, c.SpikyGradient);
+            }
           }
           strength += k * r2; // each wall dummy once: it fills its lattice site
           return k;
@@ -387,8 +409,13 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
         // The fluid pairs' G_ij as the solves use them: rounded to float (the pair list), the sums from those.
         for (Index s = fs[i]; s < fs[i + 1]; ++s)
         {
-          double r[3];
-          const double k = coefficient(x + 3 * static_cast<Index>(fn[s]), r);
+          double r[3], r2, distance;
+          const double k = coefficient(x + 3 * static_cast<Index>(fn[s]), r, r2, distance);
+          if (shapes)
+          {
+            shape[s].Viscous = static_cast<float>(c.H - distance);
+            shape[s].Artificial = k > 0.0 ? static_cast<float>(1.0 / (k * (r2 + c.ArtificialEpsilon))) : 0.0f;
+          }
           GradientPair& out = pair[s];
           out.Neighbor = fn[s];
           double g[3];
@@ -403,8 +430,8 @@ void SPHFluid::DivergenceFreeFields(SPHState& state)
         const double fluidSum[3] = { sum[0], sum[1], sum[2] };
         for (Index s = bs[i]; s < bs[i + 1]; ++s)
         {
-          double r[3];
-          const double k = coefficient(bx + 3 * static_cast<Index>(bn[s]), r); // static: no term of their own
+          double r[3], r2, distance;
+          const double k = coefficient(bx + 3 * static_cast<Index>(bn[s]), r, r2, distance); // static: no own term
           wall[s] = k;
           for (int a = 0; a < 3; ++a)
           {
@@ -660,7 +687,7 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
       [&](Index begin, Index end) {
         for (Index i = begin; i < end; ++i)
         {
-          d[i] = beta == 0.0 ? z[i] : z[i] + beta * d[i];
+          d[i] = beta == 0.0 ? z[i] : (isFree[i] ? z[i] + beta * d[i] : 0.0);
         }
       },
       ParallelThreshold);
@@ -694,7 +721,7 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
     // the same pass.
     struct Step
     {
-      double DAd = 0.0, Limit = std::numeric_limits<double>::infinity();
+      double DAd = 0.0, Dr = 0.0, Limit = std::numeric_limits<double>::infinity();
     };
     const Step st = ParallelReduce(
       n, 1024, Step(),
@@ -704,6 +731,7 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
         {
           ad[i] = -errorAt(u, i, false);
           s.DAd += d[i] * ad[i];
+          s.Dr += d[i] * r[i];
           if (d[i] < 0.0)
           {
             s.Limit = std::min(s.Limit, q[i] / -d[i]);
@@ -713,6 +741,7 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
       },
       [](Step a, const Step& b) {
         a.DAd += b.DAd;
+        a.Dr += b.Dr;
         a.Limit = std::min(a.Limit, b.Limit);
         return a;
       },
@@ -721,8 +750,16 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
     {
       break;
     }
-    const double step = rz / st.DAd;
     ++iterations;
+    if (!(st.Dr > 0.0))
+    {
+      // After an expansion the direction kept its conjugate part (below) and need not descend: restart on z.
+      sums = precondition(true, 0.0);
+      rz = sums.Rz;
+      direction(0.0);
+      continue;
+    }
+    const double step = st.Dr / st.DAd; // the exact line search (d . r = r . z for a conjugate direction)
     bool restart = false;
     if (step > st.Limit)
     {
@@ -741,8 +778,7 @@ int SPHFluid::DivergenceFreeSolve(SPHState& state, double dt, bool density, doub
         ParallelThreshold);
       impulse(dq, v, true);
       errors(v, r, true);
-      restart = true;
-      sums = precondition(false, 0.0);
+      sums = precondition(true, 0.0);
     }
     else
     {
@@ -829,12 +865,12 @@ bool SPHFluid::ChooseDivergenceFreeStep(
   };
   if (p.CFLNumber > 0.0)
   {
-    dt = std::min(p.TimeStep, stable(std::min(p.CFLNumber, StabilityLambda)));
+    dt = std::min(p.TimeStep, stable(std::min(p.CFLNumber, MaximumCFLNumber(SPHSolver::DFSPH))));
   }
   else
   {
     dt = p.TimeStep;
-    const double limit = stable(StabilityLambda);
+    const double limit = stable(MaximumCFLNumber(SPHSolver::DFSPH));
     if (dt > limit)
     {
       dt = limit;
@@ -934,20 +970,37 @@ SPHFluid::Status SPHFluid::AdvanceDivergenceFree(SPHState& state, double targetT
       double* acc = state.Acceleration.data();
       double* vNew = state.Velocity.data();
       const double* kappa = state.DensityStiffness.data();
+      const SPHGradientPair* pairs = this->Pairs.data();
+      const SPHPairShape* shapes = this->PairShapes.empty() ? nullptr : this->PairShapes.data();
       ParallelFor(
         n, 256,
         [&](Index begin, Index end) {
           for (Index i = begin; i < end; ++i)
           {
             SPHAcceleration a(x + 3 * i, v + 3 * i, rho[i], inverse[i], 0.0);
-            for (Index s = fs[i]; s < fs[i + 1]; ++s)
+            if (shapes != nullptr)
             {
-              const Index j = fn[s];
-              a.Fluid(x + 3 * j, v + 3 * j, rho[j], inverse[j], 0.0, c);
+              // From the pair list (no surface tension): a wall dummy adds nothing here (its pressure term is the
+              // solves', and there is no artificial viscosity against walls).
+              for (Index s = fs[i]; s < fs[i + 1]; ++s)
+              {
+                const SPHGradientPair& e = pairs[s];
+                const Index j = e.Neighbor;
+                const double g[3] = { e.Gradient[0], e.Gradient[1], e.Gradient[2] };
+                a.NonPressure(g, shapes[s].Viscous, shapes[s].Artificial, v + 3 * j, rho[j], inverse[j], c);
+              }
             }
-            for (Index s = bs[i]; s < bs[i + 1]; ++s)
+            else
             {
-              a.Wall(bx + 3 * static_cast<Index>(bn[s]), 0.0, c);
+              for (Index s = fs[i]; s < fs[i + 1]; ++s)
+              {
+                const Index j = fn[s];
+                a.Fluid(x + 3 * j, v + 3 * j, rho[j], inverse[j], 0.0, c);
+              }
+              for (Index s = bs[i]; s < bs[i + 1]; ++s)
+              {
+                a.Wall(bx + 3 * static_cast<Index>(bn[s]), 0.0, c);
+              }
             }
             a.Finish(acc + 3 * i, c);
             // The hydrostatic part of the mirrored wall pressure (Adami et al. 2012, eq. 27): p_b = p_i + rho_i g .
@@ -964,13 +1017,11 @@ SPHFluid::Status SPHFluid::AdvanceDivergenceFree(SPHState& state, double targetT
                 const double r[3] = { xi[0] - xb[0], xi[1] - xb[1], xi[2] - xb[2] };
                 const double rise =
                   std::max(-(c.Gravity[0] * r[0] + c.Gravity[1] * r[1] + c.Gravity[2] * r[2]), floor);
-                if (rise != 0.0)
-                {
-                  const double k = this->WallCoefficient[s] * rise * inverse[i];
-                  acc[3 * i] += k * r[0];
-                  acc[3 * i + 1] += c.Dimension == 2 ? 0.0 : k * r[1];
-                  acc[3 * i + 2] += k * r[2];
-                }
+                // (no branch on rise = 0, a dummy level with the particle: it adds +-0, leaving acc as it is)
+                const double k = this->WallCoefficient[s] * rise * inverse[i];
+                acc[3 * i] += k * r[0];
+                acc[3 * i + 1] += c.Dimension == 2 ? 0.0 : k * r[1];
+                acc[3 * i + 2] += k * r[2];
               }
             }
             for (int k = 0; k < 3; ++k)

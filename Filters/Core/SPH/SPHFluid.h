@@ -201,6 +201,15 @@ struct SPHGradientPair
   std::int32_t Neighbor;
 };
 
+/// DFSPH's second pair stream, beside SPHGradientPair: what the non-pressure accelerations need of the pair besides
+/// G_ij = k (x_i - x_j) (SPHAcceleration::NonPressure): h - |r| (viscosity) and 1 / (k (|r|^2 + eps)) (artificial
+/// viscosity; 0 where k = 0), in single precision, 8 bytes.
+struct SPHPairShape
+{
+  float Viscous;
+  float Artificial;
+};
+
 class SPHFluid
 {
 public:
@@ -284,6 +293,11 @@ public:
   /// Largest stable step for the current state and CFL factor lambda (see the header comment).
   double StableTimeStep(const SPHState& state, double lambda) const;
 
+  /// The largest CFLNumber a solver uses (larger values are reduced to it, with a warning): WCSPH 0.4, the
+  /// leap-frog's stability limit; DFSPH 1, where its step 0.4 lambda h / v_max lets no particle move more than
+  /// 0.4 h (0.8 dx with h = 2 dx) a step (SPHDivergenceFree.cxx, step 2).
+  static double MaximumCFLNumber(SPHSolver solver) { return solver == SPHSolver::DFSPH ? 1.0 : 0.4; }
+
 private:
   /// The step of the state whose CFL maxima are `e` at `time` towards `targetTime`, `steps` already taken in
   /// this call (TimeStep, CFL, the stability reduction, the landing on targetTime); false with Error set when the
@@ -323,6 +337,9 @@ private:
   // rounding keeps G_ji = -G_ij exact). The wall pairs' coefficients m GradientNorm shape(r), and each particle's own
   // sum_f G + 2 sum_b G (3 per particle, the fluid part summed from the rounded G_ij).
   std::vector<SPHGradientPair> Pairs;
+  // The same pairs' SPHPairShape: the non-pressure pass reads the pair list instead of the positions (no distance,
+  // no square root, no kernel per pair); filled only when that pass uses it (no surface tension).
+  std::vector<SPHPairShape> PairShapes;
   std::vector<double> WallCoefficient, SelfGradient;
   std::vector<double> Alpha, Kappa, KappaOverRho, OldVelocity, Smoothed;
   // DFSPH: each particle's pressure impulse, sum over the steps of the current Advance() call of dt rho (kappa_density

@@ -247,10 +247,15 @@ struct SPHAcceleration
         const double vr = (vi[0] - vj[0]) * r[0] + (vi[1] - vj[1]) * r[1] + (vi[2] - vj[2]) * r[2];
         pair += vr < 0.0 ? -c.ArtificialFactor * vr / (0.5 * (this->RhoI + rhoJ) * (r2 + c.ArtificialEpsilon)) : 0.0;
       }
-      const double coefficient = c.PressureFactor * pair * SPHGradientShape(r2, dist, c.H, c.H2, c.SpikyGradient);
-      this->Ap[0] += coefficient * r[0];
-      this->Ap[1] += coefficient * r[1];
-      this->Ap[2] += coefficient * r[2];
+      // A zero pair term (both pressures 0 and no artificial viscosity: DFSPH's non-pressure pass for every pair
+      // moving apart, WCSPH at the free surface) would add +-0 to Ap, which is never -0: skipping it keeps the bits.
+      if (pair != 0.0)
+      {
+        const double coefficient = c.PressureFactor * pair * SPHGradientShape(r2, dist, c.H, c.H2, c.SpikyGradient);
+        this->Ap[0] += coefficient * r[0];
+        this->Ap[1] += coefficient * r[1];
+        this->Ap[2] += coefficient * r[2];
+      }
     }
     if (c.Viscous)
     {
@@ -262,6 +267,36 @@ struct SPHAcceleration
     if (c.Tension)
     {
       this->Colour(c.Mass * inverseJ, r, r2, c);
+    }
+  }
+
+  /// Fluid() of a pair with zero pressures (DFSPH's non-pressure accelerations) from its pair-list entry instead of
+  /// the positions: g = G_ij = k r with k = PressureFactor shape(|r|) (-m grad W, lattice-corrected), viscous = h - |r|
+  /// and artificial = 1 / (k (|r|^2 + ArtificialEpsilon)) (0 where k = 0), so that Monaghan's term
+  /// -ArtificialFactor (v_ij . r) / (rho_bar (r^2 + eps)) G_ij is -ArtificialFactor (v_ij . g) artificial / rho_bar g.
+  /// No surface tension (it needs r itself: Fluid()).
+  MESHFREE_HD void NonPressure(const double g[3], double viscous, double artificial, const double* vj, double rhoJ,
+    double inverseJ, const SPHConstants& c)
+  {
+    const double* vi = this->Vi;
+    const double dv[3] = { vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2] };
+    if (c.Artificial)
+    {
+      // Approaching pairs only (v_ij . r < 0), without a branch: which pairs approach is close to random, and a
+      // receding pair adds +-0, which leaves Ap as it is.
+      const double vg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
+      const double approach = vg < 0.0 ? -vg : 0.0; // a max, not fmax (a library call here)
+      const double pair = c.ArtificialFactor * approach * artificial / (0.5 * (this->RhoI + rhoJ));
+      this->Ap[0] += pair * g[0];
+      this->Ap[1] += pair * g[1];
+      this->Ap[2] += pair * g[2];
+    }
+    if (c.Viscous)
+    {
+      const double coefficient = c.ViscousFactor * viscous * this->InverseI * inverseJ;
+      this->Av[0] -= coefficient * dv[0];
+      this->Av[1] -= coefficient * dv[1];
+      this->Av[2] -= coefficient * dv[2];
     }
   }
 

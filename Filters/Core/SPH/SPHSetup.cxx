@@ -125,12 +125,20 @@ void SPHFluid::Setup(const SPHParameters& parameters, const std::vector<double>&
       }
     }
   }
-  if (p.CFLNumber > StabilityLambda)
+  if (p.CFLNumber > MaximumCFLNumber(p.Solver))
   {
     std::ostringstream s;
-    s << "CFLNumber " << p.CFLNumber << " is above " << StabilityLambda
-      << ", the stability limit of the leap-frog step: every step is limited to " << StabilityLambda
-      << " x the stable step (and to TimeStep)";
+    if (p.Solver == SPHSolver::DFSPH)
+    {
+      s << "CFLNumber " << p.CFLNumber << " is above 1, the largest DFSPH step (no particle moves more than 0.4 "
+        << "support radii a step): every step is limited to 0.4 h / v_max (and to TimeStep)";
+    }
+    else
+    {
+      s << "CFLNumber " << p.CFLNumber << " is above " << StabilityLambda
+        << ", the stability limit of the leap-frog step: every step is limited to " << StabilityLambda
+        << " x the stable step (and to TimeStep)";
+    }
     this->WarningList.push_back(s.str());
   }
   if (p.Kernels == SPHKernelPair::Mueller)
