@@ -409,14 +409,15 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   {
     blockBegin[b + 1] += blockBegin[b];
   }
-  detail::Buffer<std::pair<std::uint64_t, std::int32_t>> members(blockBegin.back(), std::pair<std::uint64_t, std::int32_t>());
+  // (Sorted positions only, 4 bytes each: the block is known by its range in blockBegin.)
+  detail::Buffer<std::int32_t> members(blockBegin.back(), 0);
   {
     std::vector<size_t> fill(blockBegin.begin(), blockBegin.end() - 1);
     for (Index s = 0; s < nv; ++s)
     {
       if (blockIndex[s] >= 0)
       {
-        members[fill[blockIndex[s]]++] = { blockOf[s], static_cast<std::int32_t>(s) };
+        members[fill[blockIndex[s]]++] = static_cast<std::int32_t>(s);
       }
     }
   }
@@ -476,6 +477,14 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
     });
   }
   detail::Buffer<std::int32_t>().swap(linked);
+  // The positions by id were for the edges; distributed, `state` answers for them below (issue 24: a rank's peak is
+  // in the propagation).
+  detail::Buffer<unsigned char>().swap(inBlock);
+  detail::Buffer<unsigned char>().swap(valid);
+  if (d)
+  {
+    detail::Buffer<std::int32_t>().swap(rank);
+  }
 
   // Prim's propagation inside each block (blocks in parallel): components numbered in the block from its first
   // point in sorted order. Only edges whose normals agree up to sign within 60 degrees are followed: a block
@@ -495,7 +504,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       std::int64_t count = 0;
       for (size_t m = blockBegin[b]; m < blockBegin[b + 1]; ++m)
       {
-        const std::int32_t seed = members[m].second;
+        const std::int32_t seed = members[m];
         if (done[seed])
         {
           continue;
@@ -548,6 +557,12 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       blockComponents[b] = count;
     }
   });
+  // The propagation's graph and queues go before the nodes' state and votes are allocated.
+  detail::Buffer<std::int32_t>().swap(adjacent);
+  detail::Buffer<Index>().swap(offsets);
+  detail::Buffer<float>().swap(key);
+  detail::Buffer<unsigned char>().swap(done);
+  detail::Buffer<std::int32_t>().swap(parent);
   // The nodes of the blocks oriented here, numbered block by block (sorted: blocks, then components).
   std::vector<size_t> nodeBegin(wanted.size() + 1, 0);
   for (size_t b = 0; b < wanted.size(); ++b)
@@ -599,7 +614,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       }
       for (size_t m = blockBegin[b]; m < blockBegin[b + 1]; ++m)
       {
-        const std::int32_t s = members[m].second;
+        const std::int32_t s = members[m];
         const Index id = order[s];
         if (!IsOwn(d, id))
         {
@@ -715,7 +730,7 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
       const size_t first = indexOf(Node{ wanted[b], 0 });
       for (size_t m = blockBegin[b]; m < blockBegin[b + 1]; ++m)
       {
-        const std::int32_t s = members[m].second;
+        const std::int32_t s = members[m];
         const Index i = order[s];
         const double sign = signOf(i) * turn[first + static_cast<size_t>(component[s])];
         for (int a = 0; a < 3; ++a)
