@@ -21,13 +21,10 @@ vtkMeshFreeHaloDistribution::vtkMeshFreeHaloDistribution(
   , Radius(radius)
 {
   std::copy(region, region + 6, this->Region);
+  // The keys are read where the halo holds them (no copy: 8 bytes per held point, issue 24).
   vtkIdTypeArray* ids = halo->GetGlobalIds();
-  const vtkIdType n = halo->GetOutput()->GetNumberOfPoints();
-  this->Ids.resize(static_cast<size_t>(n));
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    this->Ids[i] = ids ? static_cast<std::int64_t>(ids->GetValue(i)) : static_cast<std::int64_t>(i);
-  }
+  this->Count = halo->GetOutput()->GetNumberOfPoints();
+  this->Ids = ids && ids->GetNumberOfTuples() >= this->Count ? ids->GetPointer(0) : nullptr;
 }
 
 vtkMeshFreeHaloDistribution::vtkMeshFreeHaloDistribution(vtkMultiProcessController* controller, vtkIdType n)
@@ -35,13 +32,9 @@ vtkMeshFreeHaloDistribution::vtkMeshFreeHaloDistribution(vtkMultiProcessControll
   , Halo(nullptr)
   , NumberOfOwned(n)
   , Radius(0.0)
-  , Ids(static_cast<size_t>(n))
+  , Count(n)
 {
   std::fill(this->Region, this->Region + 6, 0.0);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    this->Ids[i] = i;
-  }
 }
 
 double vtkMeshFreeHaloDistribution::Complete(const double x[3]) const
@@ -90,7 +83,7 @@ void vtkMeshFreeHaloDistribution::UpdateHalo(double* values, int components) con
   }
   vtkNew<vtkDoubleArray> array;
   array->SetNumberOfComponents(components);
-  array->SetArray(values, static_cast<vtkIdType>(this->Ids.size()) * components, 1); // 1: not freed by the array
+  array->SetArray(values, this->Count * components, 1); // 1: not freed by the array
   this->Halo->UpdateHalo(array);
 }
 

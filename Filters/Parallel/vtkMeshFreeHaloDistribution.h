@@ -25,7 +25,8 @@ class vtkMultiProcessController;
 class vtkMeshFreeHaloDistribution : public meshfree::Distribution
 {
 public:
-  /// The halo must have exchanged (Exchange, with `region` and `radius`) before; it must outlive this object.
+  /// The halo must have exchanged (Exchange, with `region` and `radius`) before; it must outlive this object, and its
+  /// output's GlobalIds (the keys, read in place) must stay while this object is used.
   vtkMeshFreeHaloDistribution(
     vtkMultiProcessController* controller, vtkMeshFreeHalo* halo, const double region[6], double radius);
   /// Without a halo: n points, all this rank's own (keys: their indices); for reductions and selections only.
@@ -34,7 +35,7 @@ public:
   int Rank() const override;
   int Size() const override;
   bool Owned(meshfree::Index i) const override { return i < this->NumberOfOwned; }
-  std::int64_t Key(meshfree::Index i) const override { return this->Ids[static_cast<size_t>(i)]; }
+  std::int64_t Key(meshfree::Index i) const override { return this->Ids ? static_cast<std::int64_t>(this->Ids[i]) : i; }
   void Sum(double* values, meshfree::Index count) const override;
   void Sum(std::int64_t* values, meshfree::Index count) const override;
   void Max(double* values, meshfree::Index count) const override;
@@ -55,7 +56,8 @@ private:
   meshfree::Index NumberOfOwned = 0;
   double Region[6];
   double Radius;
-  std::vector<std::int64_t> Ids;
+  vtkIdType Count = 0;             // points held
+  const vtkIdType* Ids = nullptr; // the halo's global ids (its output's GlobalIds), null: the keys are the indices
   int SlabAxis = -1;
   double SlabLower = 0.0;
   double SlabUpper = 0.0;
