@@ -81,8 +81,8 @@ bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* con
 {
   // This rank's points (and reference normals), with the input's global ids when it has them.
   const vtkIdType n = input->GetNumberOfPoints();
-  vtkNew<vtkPolyData> mine;
-  vtkNew<vtkPoints> points;
+  auto mine = vtkSmartPointer<vtkPolyData>::New();
+  auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(n);
   for (vtkIdType i = 0; i < n; ++i)
@@ -124,6 +124,7 @@ bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* con
   {
     radius = std::max(radius, 2.0 * options.Neighborhood.SupportRadius);
   }
+  points = nullptr; // (`mine` holds them until the exchange)
   vtkNew<vtkMeshFreeHalo> halo;
   halo->SetController(controller);
   for (int attempt = 0; attempt < 4; ++attempt)
@@ -132,7 +133,49 @@ bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* con
     {
       radius = std::numeric_limits<double>::infinity();
     }
+    if (!mine)
+    {
+      // A retry: this rank's points again, from the last halo's owned points (the first ones, in order), with their
+      // reference normals and global ids.
+      vtkPolyData* last = halo->GetOutput();
+      const vtkIdType own = halo->GetNumberOfOwnedPoints();
+      mine = vtkSmartPointer<vtkPolyData>::New();
+      vtkNew<vtkPoints> again;
+      again->SetDataTypeToDouble();
+      again->SetNumberOfPoints(own);
+      for (vtkIdType i = 0; i < own; ++i)
+      {
+        again->SetPoint(i, last->GetPoint(i));
+      }
+      mine->SetPoints(again);
+      vtkPointData* lastPD = last->GetPointData();
+      for (vtkDataArray* from : { lastPD->GetArray(kNormals), lastPD->GetGlobalIds() })
+      {
+        if (from)
+        {
+          vtkSmartPointer<vtkDataArray> copy = vtk::TakeSmartPointer(from->NewInstance());
+          copy->SetName(from->GetName());
+          copy->SetNumberOfComponents(from->GetNumberOfComponents());
+          copy->SetNumberOfTuples(own);
+          for (vtkIdType i = 0; i < own; ++i)
+          {
+            copy->SetTuple(i, i, from);
+          }
+          if (from == lastPD->GetGlobalIds())
+          {
+            mine->GetPointData()->SetGlobalIds(copy);
+          }
+          else
+          {
+            mine->GetPointData()->AddArray(copy);
+          }
+        }
+      }
+    }
     halo->Exchange(mine, region, radius);
+    // This rank's points live on in the halo's output (its first ones): released here (24 bytes or more per own
+    // point through the whole run, issue 24), rebuilt for a retry.
+    mine = nullptr;
     run.Radius = radius;
     run.Attempts = attempt + 1;
     vtkMeshFreeHaloDistribution processes(controller, halo, region, radius);
