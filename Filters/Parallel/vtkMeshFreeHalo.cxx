@@ -185,6 +185,48 @@ vtkIdTypeArray* vtkMeshFreeHalo::GetGlobalIds()
   return vtkIdTypeArray::SafeDownCast(this->Output->GetPointData()->GetGlobalIds());
 }
 
+vtkSmartPointer<vtkPolyData> vtkMeshFreeHalo::CopyOwnedPoints()
+{
+  auto owned = vtkSmartPointer<vtkPolyData>::New();
+  vtkPolyData* out = this->Output;
+  const vtkIdType n = out ? this->NumberOfOwnedPoints : 0;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    points->SetPoint(i, out->GetPoint(i));
+  }
+  owned->SetPoints(points);
+  vtkPointData* from = out ? out->GetPointData() : nullptr;
+  for (int a = 0; from && a < from->GetNumberOfArrays(); ++a)
+  {
+    vtkDataArray* array = from->GetArray(a);
+    const char* name = array ? array->GetName() : nullptr;
+    if (!array || (name && !strcmp(name, vtkDataSetAttributes::GhostArrayName())))
+    {
+      continue;
+    }
+    vtkSmartPointer<vtkDataArray> copy = vtk::TakeSmartPointer(array->NewInstance());
+    copy->SetName(name);
+    copy->SetNumberOfComponents(array->GetNumberOfComponents());
+    copy->SetNumberOfTuples(n);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      copy->SetTuple(i, i, array);
+    }
+    if (array == from->GetGlobalIds())
+    {
+      owned->GetPointData()->SetGlobalIds(copy);
+    }
+    else
+    {
+      owned->GetPointData()->AddArray(copy);
+    }
+  }
+  return owned;
+}
+
 vtkSmartPointer<vtkPolyData> vtkMeshFreeHalo::OwnedCloud(vtkPointSet* local)
 {
   // Collective: the id offsets need every rank's count.

@@ -115,6 +115,9 @@ public:
   vtkPolyData* GetOutput();
   vtkIdType GetNumberOfOwnedPoints() const { return this->NumberOfOwnedPoints; }
   vtkIdTypeArray* GetGlobalIds();
+  /// A new cloud of this rank's own points (the output's first ones) with the output's point arrays but its ghost
+  /// marks, the global ids as its GlobalIds: what a retry with a wider radius exchanges again.
+  vtkSmartPointer<vtkPolyData> CopyOwnedPoints();
   double GetRadius() const { return this->Radius; }
   int GetNumberOfRounds() const { return this->NumberOfRounds; }
   vtkIdType GetNumberOfGlobalPoints() const { return this->NumberOfGlobalPoints; }

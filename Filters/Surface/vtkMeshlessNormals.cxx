@@ -135,42 +135,7 @@ bool ComputeDistributed(vtkMeshlessNormals* self, vtkMultiProcessController* con
     }
     if (!mine)
     {
-      // A retry: this rank's points again, from the last halo's owned points (the first ones, in order), with their
-      // reference normals and global ids.
-      vtkPolyData* last = halo->GetOutput();
-      const vtkIdType own = halo->GetNumberOfOwnedPoints();
-      mine = vtkSmartPointer<vtkPolyData>::New();
-      vtkNew<vtkPoints> again;
-      again->SetDataTypeToDouble();
-      again->SetNumberOfPoints(own);
-      for (vtkIdType i = 0; i < own; ++i)
-      {
-        again->SetPoint(i, last->GetPoint(i));
-      }
-      mine->SetPoints(again);
-      vtkPointData* lastPD = last->GetPointData();
-      for (vtkDataArray* from : { lastPD->GetArray(kNormals), lastPD->GetGlobalIds() })
-      {
-        if (from)
-        {
-          vtkSmartPointer<vtkDataArray> copy = vtk::TakeSmartPointer(from->NewInstance());
-          copy->SetName(from->GetName());
-          copy->SetNumberOfComponents(from->GetNumberOfComponents());
-          copy->SetNumberOfTuples(own);
-          for (vtkIdType i = 0; i < own; ++i)
-          {
-            copy->SetTuple(i, i, from);
-          }
-          if (from == lastPD->GetGlobalIds())
-          {
-            mine->GetPointData()->SetGlobalIds(copy);
-          }
-          else
-          {
-            mine->GetPointData()->AddArray(copy);
-          }
-        }
-      }
+      mine = halo->CopyOwnedPoints(); // a retry: this rank's points, reference normals and global ids again
     }
     halo->Exchange(mine, region, radius);
     // This rank's points live on in the halo's output (its first ones): released here (24 bytes or more per own

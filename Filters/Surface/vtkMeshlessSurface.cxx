@@ -692,13 +692,9 @@ int vtkMeshlessSurface::ReconstructDistributed(
     }
     if (!mine)
     {
-      // A retry: this rank's slab points again, from the last halo's owned points (the first `own`, in order), their
-      // rows (the local cloud's) and their global ids (the halo's, kept).
-      vtkPolyData* last = halo->GetOutput();
-      mine = vtkSmartPointer<vtkPolyData>::New();
-      vtkNew<vtkPoints> again;
-      again->SetDataTypeToDouble();
-      again->SetNumberOfPoints(own);
+      // A retry: this rank's slab points again, from the last halo's owned points (the first `own`, in order) with
+      // their global ids (the halo's, kept), and their rows (the local cloud's).
+      mine = halo->CopyOwnedPoints();
       vtkNew<vtkDoubleArray> rowsAgain;
       rowsAgain->SetName("MeshFreeRow");
       rowsAgain->SetNumberOfComponents(std::max(rest, 1));
@@ -706,20 +702,10 @@ int vtkMeshlessSurface::ReconstructDistributed(
       std::vector<double> tail(static_cast<size_t>(std::max(rest, 1)), 0.0);
       for (vtkIdType i = 0; i < own; ++i)
       {
-        again->SetPoint(i, last->GetPoint(i));
         GetRowTail(cloud, i, tail.data());
         rowsAgain->SetTuple(i, tail.data());
       }
-      mine->SetPoints(again);
       mine->GetPointData()->AddArray(rowsAgain);
-      if (vtkIdTypeArray* ids = halo->GetGlobalIds())
-      {
-        vtkNew<vtkIdTypeArray> ownIds;
-        ownIds->SetName(ids->GetName());
-        ownIds->SetNumberOfTuples(own);
-        std::copy_n(ids->GetPointer(0), own, ownIds->GetPointer(0));
-        mine->GetPointData()->SetGlobalIds(ownIds);
-      }
     }
     halo->Exchange(mine, region, radius);
     attempts = attempt + 1;
