@@ -2,8 +2,11 @@
 // APSS: the moving algebraic-sphere fit of PointSetSurface.h.
 #include "Surface/PointSetSurface.h"
 
+#include "Common/LargeArrays.h"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace meshfree
@@ -92,8 +95,14 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
   std::vector<std::vector<double>> coordinates(bounds.size());
   std::vector<std::vector<Index>> positions(bounds.size());
   const double* xyz = grid.SortedPoints();
+  // Each sample's tier (-1: none), then the tiers' arrays at their exact sizes (grown by doubling they faulted
+  // their pages in twice: LargeArrays.h).
+  detail::Buffer<std::int8_t> tierOf;
+  tierOf.resize(static_cast<size_t>(nv));
+  std::vector<size_t> tierSize(bounds.size(), 0);
   for (Index s = 0; s < nv; ++s)
   {
+    tierOf[s] = -1;
     if (!std::isfinite(this->InverseRadii[s]))
     {
       continue;
@@ -101,9 +110,24 @@ void PointSetSurface::SetCloud(const NeighborGrid& grid, const double* normals, 
     const double r = 1.0 / this->InverseRadii[s];
     const size_t t = static_cast<size_t>(std::lower_bound(bounds.begin(), bounds.end(), r) - bounds.begin());
     const size_t tier = std::min(t, bounds.size() - 1);
-    coordinates[tier].insert(coordinates[tier].end(), xyz + 3 * s, xyz + 3 * s + 3);
-    positions[tier].push_back(s);
+    tierOf[s] = static_cast<std::int8_t>(tier);
+    ++tierSize[tier];
   }
+  for (size_t t = 0; t < bounds.size(); ++t)
+  {
+    detail::ReserveLarge(coordinates[t], 3 * tierSize[t]);
+    detail::ReserveLarge(positions[t], tierSize[t]);
+  }
+  for (Index s = 0; s < nv; ++s)
+  {
+    if (tierOf[s] >= 0)
+    {
+      const size_t tier = static_cast<size_t>(tierOf[s]);
+      coordinates[tier].insert(coordinates[tier].end(), xyz + 3 * s, xyz + 3 * s + 3);
+      positions[tier].push_back(s);
+    }
+  }
+  detail::Buffer<std::int8_t>().swap(tierOf);
   // Each tier's grid framed by the whole cloud's tier points (the same cells and order as a serial run's).
   std::vector<double> ownCoordinates;
   for (size_t t = 0; d && t < bounds.size(); ++t)

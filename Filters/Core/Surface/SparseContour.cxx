@@ -2,6 +2,7 @@
 // Sparse continuation contouring; the method is described in SparseContour.h.
 #include "Surface/SparseContour.h"
 
+#include "Common/LargeArrays.h"
 #include "Common/Parallel.h"
 
 #include <algorithm>
@@ -675,7 +676,10 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
     b.VertexBase = vertices;
     vertices += static_cast<Index>(b.EdgeCodes.size());
   }
-  std::vector<double> points(static_cast<size_t>(3 * vertices));
+  // The mesh's arrays are written once each, serially where they are assembled: scratch ones are Buffers and the
+  // large public ones are reserved on huge pages (LargeArrays.h: their first touch would cost more than the writes).
+  detail::Buffer<double> points;
+  points.resize(static_cast<size_t>(3 * vertices));
   ParallelFor(nb, 16, [&](Index begin, Index end) {
     for (Index bi = begin; bi < end; ++bi)
     {
@@ -811,18 +815,24 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
   std::vector<std::vector<double>>().swap(blockCentres);
 
   // Keep the vertices the triangles use, renumbered in order.
-  std::vector<Index> renumber(static_cast<size_t>(vertices), -1);
-  size_t triangleIds = 0;
-  for (const auto& t : blockTriangles)
+  detail::Buffer<Index> renumber;
+  renumber.assign(static_cast<size_t>(vertices), -1);
+  std::vector<size_t> blockStart(static_cast<size_t>(nb) + 1, 0);
+  for (Index bi = 0; bi < nb; ++bi)
   {
-    triangleIds += t.size();
+    blockStart[bi + 1] = blockStart[bi] + blockTriangles[bi].size();
   }
-  mesh.Triangles.reserve(triangleIds);
-  for (auto& t : blockTriangles)
-  {
-    mesh.Triangles.insert(mesh.Triangles.end(), t.begin(), t.end());
-    std::vector<Index>().swap(t);
-  }
+  mesh.Triangles.clear();
+  detail::ReserveLarge(mesh.Triangles, blockStart[nb]);
+  mesh.Triangles.resize(blockStart[nb]);
+  ParallelFor(nb, 16, [&](Index begin, Index end) {
+    for (Index bi = begin; bi < end; ++bi)
+    {
+      std::vector<Index>& t = blockTriangles[bi];
+      std::copy(t.begin(), t.end(), mesh.Triangles.begin() + static_cast<std::ptrdiff_t>(blockStart[bi]));
+      std::vector<Index>().swap(t);
+    }
+  });
   for (Index id : mesh.Triangles)
   {
     renumber[id] = 0;
@@ -835,18 +845,24 @@ bool SparseContour::Run(const ImplicitField& field, std::vector<std::uint64_t> s
       renumber[v] = kept++;
     }
   }
+  mesh.Points.clear();
+  detail::ReserveLarge(mesh.Points, static_cast<size_t>(3 * kept));
   mesh.Points.resize(static_cast<size_t>(3 * kept));
-  for (Index v = 0; v < vertices; ++v)
-  {
-    if (renumber[v] >= 0)
+  ParallelFor(vertices, 4096, [&](Index begin, Index end) {
+    for (Index v = begin; v < end; ++v)
     {
-      std::copy(&points[3 * v], &points[3 * v] + 3, &mesh.Points[3 * renumber[v]]);
+      if (renumber[v] >= 0)
+      {
+        std::copy(&points[3 * v], &points[3 * v] + 3, &mesh.Points[3 * renumber[v]]);
+      }
     }
-  }
-  for (Index& id : mesh.Triangles)
-  {
-    id = renumber[id];
-  }
+  });
+  ParallelFor(static_cast<Index>(mesh.Triangles.size()), 1 << 14, [&](Index begin, Index end) {
+    for (Index k = begin; k < end; ++k)
+    {
+      mesh.Triangles[k] = renumber[mesh.Triangles[k]];
+    }
+  });
   if (progress)
   {
     progress(1.0);

@@ -80,7 +80,7 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     std::uint64_t Key;
     Item It;
   };
-  std::vector<Keyed> keyed;
+  detail::Buffer<Keyed> keyed;
   keyed.reserve(static_cast<size_t>(std::max<Index>(count, 0)));
   for (Index i = 0; i < count; ++i)
   {
@@ -102,7 +102,7 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
   // The cubes this process holds completely (all of them when serial): their points, in cube order. The groups are
   // found first so that the points and the trees' nodes are allocated once at their exact size (a rank's peak
   // memory falls in this build: issue 24).
-  std::vector<Item> items;
+  detail::Buffer<Item> items;
   std::vector<std::pair<std::uint64_t, std::pair<Index, Index>>> held; // key, [begin, end) in items
   std::vector<size_t> heldStart;                                        // where each held cube starts in keyed
   std::vector<std::uint64_t> seen;                                      // every cube with a local point
@@ -149,7 +149,7 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     }
   }
   std::vector<size_t>().swap(heldStart);
-  std::vector<Keyed>().swap(keyed);
+  detail::Buffer<Keyed>().swap(keyed);
   this->Nodes.reserve(cubeNodes);
   std::vector<Index> heldRoot(held.size());
   for (size_t c = 0; c < held.size(); ++c)
@@ -160,13 +160,14 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
   // go before the normals and areas are allocated.
   const size_t m = items.size();
   this->Points.resize(3 * m);
-  std::vector<Index> ids(m);
+  detail::Buffer<Index> ids;
+  ids.resize(m);
   for (size_t s = 0; s < m; ++s)
   {
     std::copy(items[s].P, items[s].P + 3, &this->Points[3 * s]);
     ids[s] = items[s].Id;
   }
-  std::vector<Item>().swap(items);
+  detail::Buffer<Item>().swap(items);
   this->Normals.resize(3 * m);
   this->Areas.resize(m);
   for (size_t s = 0; s < m; ++s)
@@ -180,7 +181,7 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
     }
     this->Areas[s] = areas[i];
   }
-  std::vector<Index>().swap(ids);
+  detail::Buffer<Index>().swap(ids);
   // Moments bottom-up (within a cube's tree children always follow their parent in this->Nodes): leaves sum their
   // points, inner nodes combine their children's moments moved to their own centre (O(n) in all).
   for (size_t k = this->Nodes.size(); k-- > 0;)
@@ -234,6 +235,7 @@ void WindingNumber::Build(const double* points, const double* normals, const dou
   // Every cube's root: this process' own cubes' (by their centre) from the trees just built, the others' from the
   // processes that own them (serial: all of them here).
   std::vector<double> mine, all;
+  detail::ReserveLarge(mine, held.size() * kRecord);
   for (size_t c = 0; c < held.size(); ++c)
   {
     double centre[3];
@@ -502,7 +504,7 @@ void WindingNumber::Combine(Node& node, const Node& left, const Node& right) con
   }
 }
 
-Index WindingNumber::BuildNode(Index begin, Index end, std::vector<Item>& items)
+Index WindingNumber::BuildNode(Index begin, Index end, detail::Buffer<Item>& items)
 {
   const Index id = static_cast<Index>(this->Nodes.size());
   this->Nodes.push_back(Node());

@@ -36,6 +36,7 @@
 #define meshfree_WindingNumber_h
 
 #include "Common/Distribution.h"
+#include "Common/LargeArrays.h"
 #include "Common/NeighborGrid.h"
 
 #include <atomic>
@@ -98,7 +99,7 @@ private:
     double P[3];
     Index Id;
   };
-  Index BuildNode(Index begin, Index end, std::vector<Item>& items);
+  Index BuildNode(Index begin, Index end, detail::Buffer<Item>& items);
   /// A leaf of the top tree: a cube's root this process built (Held, an index in Nodes) or the gathered record of
   /// another process' cube (Record: centre, moment, second, third, radius, area).
   struct TopLeaf
@@ -137,11 +138,13 @@ private:
   }
   /// `node`'s moments from its two children's.
   void Combine(Node& node, const Node& left, const Node& right) const;
-  std::vector<Node> Nodes, Top; // the cubes' trees (each allocated at its exact size), the top tree over them
+  // The cubes' trees (each allocated at its exact size), the top tree over them; they and the points below are
+  // scratch-sized arrays on huge pages (LargeArrays.h): built serially while the contour's other threads wait.
+  detail::Buffer<Node> Nodes, Top;
   Index Root = 0;
   double BuildShortfall = -HUGE_VAL;
   mutable std::atomic<bool> Opened{ false };
-  std::vector<double> Points, Normals, Areas; // tree order (a point's regularisation radius squared: Areas / pi)
+  detail::Buffer<double> Points, Normals, Areas; // tree order (a point's regularisation radius squared: Areas / pi)
   double Beta2 = 4.0;
   double Total = 0.0;
 };
