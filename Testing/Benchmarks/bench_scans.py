@@ -7,6 +7,7 @@ range scans, on virtual scans of known shapes and on single-view scans; every ou
     pvpython --no-mpi Testing/Benchmarks/bench_scans.py --data DATA --virtual VIRTUAL \
         [--cases bunny,bunny_view,vscan_torus,...] [--tools meshfree,pcl,meshlab,cgal,vtk] [--timeout 900]
         [--out Testing/Benchmarks/results] [--work DIR] [--set-env NAME=VALUE]
+    ... --merge --rescore      scores again the meshes left in --work by an earlier run (after a scorer change)
 
 Nothing is downloaded: --data holds what scans_data.py prepared (NAME.xyz, NAME_view.xyz, NAME_ref.npz,
 NAME.json), --virtual what virtual_scan.py wrote. Cases: each prepared real scan NAME (all views merged,
@@ -31,7 +32,8 @@ several-fold on a busy 2-core machine) and VTK_SMP_BACKEND_IN_USE=STDThread unle
 The CGAL driver is $SCANS_CGAL_PEER, else <source>/build/scans-peers/cgal_peer (setup_peers.sh builds it).
 
 Scores (scans_score.py): delta = 0.4 % of the cloud's bounding-box diagonal (1.1e-3 on the bunny) is the "has
-data" radius; rms/p99/max over the mesh vertices within delta of a data point, to the reference; coverage of the
+data" radius; rms/p99/max over the mesh vertices within delta of a data point, to the reference (inner: without
+those over the reference's holes; area: the same over an area-uniform sample of the mesh); coverage of the
 reference where it has data; boundary edges, pieces, stray triangles, chi; border = p99 distance of the mesh's
 boundary vertices to the nearest data point, in data spacings (open scans: the border should follow the data's).
 Writes OUT/scans.md (tables) and OUT/scans_runs.json (every row, the commands, the load averages).
@@ -322,16 +324,19 @@ def write_report(out, rows, header):
         lines += ["", "### %s" % c["label"], "",
                   "%d points, spacing %.2e, delta %.2e; reference: %s." % (c["n"], c["spacing"], c["delta"], c["reference"]),
                   "",
-                  "| tool | setting | rms | p99 | max | scored | cov rms | cov p99 | cov far | boundary edges | "
-                  "pieces (stray tri.) | chi | border p99 / h | triangles | wall s | tool s | peak MB |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                  "| tool | setting | rms | p99 | max | scored | inner rms | inner p99 | area rms | area p99 | cov rms | "
+                  "cov p99 | cov far | boundary edges | pieces (stray tri.) | chi | border p99 / h | triangles | wall s | "
+                  "tool s | peak MB |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in rs:
             if r.get("status") != "ok":
-                lines.append("| %s | %s | %s |%s" % (r["tool"], r["setting"], r.get("status"), " |" * 14))
+                lines.append("| %s | %s | %s |%s" % (r["tool"], r["setting"], r.get("status"), " |" * 18))
                 continue
-            lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s |" % (
+            lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | "
+                         "%s | %s | %s |" % (
                 r["tool"], r["setting"], fmt(r.get("rms")), fmt(r.get("p99")), fmt(r.get("max")),
-                fmt(r.get("scored_share"), "%.3f"), fmt(r.get("cov_rms")), fmt(r.get("cov_p99")),
+                fmt(r.get("scored_share"), "%.3f"), fmt(r.get("inner_rms")), fmt(r.get("inner_p99")),
+                fmt(r.get("area_rms")), fmt(r.get("area_p99")), fmt(r.get("cov_rms")), fmt(r.get("cov_p99")),
                 fmt(r.get("cov_far_share"), "%.4f"), fmt(r.get("boundary_edges")), fmt(r.get("pieces")),
                 fmt(r.get("stray_triangles")), fmt(r.get("euler")), fmt(r.get("border_p99_h") if r.get("boundary_edges") else None, "%.1f"),
                 fmt(r.get("triangles")), fmt(r.get("wall_s"), "%.1f"), fmt(r.get("algo_s"), "%.1f"),
@@ -361,6 +366,10 @@ def main():
                     help="also keep the rows of this scans_runs.json (another run's) that this run does not redo; "
                          "where several sources have the same case, tool and setting, the last one given wins")
     ap.add_argument("--report-only", action="store_true", help="run nothing: rewrite OUT/scans.md from the rows kept")
+    ap.add_argument("--rescore", action="store_true",
+                    help="run no tool: score again the meshes an earlier run left in WORK, for the rows kept (OUT's "
+                         "with --merge, or --merge-from's) of the same case, tool and setting (e.g. after a change of "
+                         "the scorer); their times and memory stay as measured")
     a = ap.parse_args()
     env = {k: v for k, v in os.environ.items() if not k.startswith("OMP_")}
     env["OMP_WAIT_POLICY"] = "passive"
@@ -392,7 +401,7 @@ def main():
             earlier = json.load(open(src))
             kept += earlier["rows"]
             starts.append(earlier.get("started", "?"))
-        started = " and ".join(starts + ([] if a.report_only else [started]))
+        started = " and ".join(starts + ([] if a.report_only or a.rescore else [started]))
         latest = {}  # the same case, tool and setting in several sources: the later source's row
         for r in kept:
             latest[(r["case"], r["tool"], r["setting"])] = r
@@ -409,6 +418,12 @@ def main():
                    if case["kind"] == "virtual" else REFERENCE_NAMES.get(os.path.basename(case["ref"]),
                                                                        os.path.basename(case["ref"])))
         for tool, setting, commands, out in tool_runs(case, tools, a.work, props, env):
+            if a.rescore:
+                earlier = [r for r in kept if (r["case"], r["tool"], r["setting"]) == (case["name"], tool, setting)]
+                if earlier and earlier[-1].get("status") == "ok" and os.path.exists(out):
+                    log("%s: %s %s: scored again" % (case["name"], tool, setting))
+                    rows.append(dict(earlier[-1], **score(case, out, ref, delta)))
+                continue
             if os.path.exists(out):
                 os.unlink(out)
             log("%s: %s %s ..." % (case["name"], tool, setting))
@@ -425,7 +440,7 @@ def main():
                     row["status"] = "unscored: %s" % e
             else:
                 row["status"] = "timeout" if run["rc"] == "timeout" else "failed"
-            log("  %s" % json.dumps({k: row.get(k) for k in ("status", "rms", "cov_far_share", "boundary_edges",
+            log("  %s" % json.dumps({k: row.get(k) for k in ("status", "rms", "inner_rms", "area_rms", "cov_far_share", "boundary_edges",
                                                               "pieces", "euler", "wall_s", "peak_mb")}))
             rows.append(row)
             redone = {(r["case"], r["tool"], r["setting"]) for r in rows}
@@ -451,6 +466,9 @@ def main():
               "Environment: OMP_WAIT_POLICY=passive, VTK_SMP_BACKEND_IN_USE=%s; 1-minute load averages before the "
               "runs: %s." % (env["VTK_SMP_BACKEND_IN_USE"], ", ".join("%.1f" % r["load1"] for r in rows)),
               "rms / p99 / max: mesh vertices within delta of a data point, to the reference; scored: their share; "
+              "inner: the same vertices but those whose closest reference point is on the reference's border (over "
+              "its holes); area: the inner scores over an area-uniform sample of the mesh within delta of the data "
+              "instead of its vertices (independent of the tessellation); "
               "cov: reference samples where the data are, to the mesh (far: share farther than delta); border: p99 "
               "distance of boundary vertices to the data in spacings h; wall s: the whole process(es); tool s: the "
               "tool's own algorithm time where it reports one; peak MB: the process's peak resident memory."]

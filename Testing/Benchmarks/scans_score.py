@@ -10,6 +10,15 @@ Mesh scores (score_mesh):
   scored_share                             share of the vertices within `delta` of a data point: "where the
                                            reference has data" - only those are scored against the reference
   rms, p99, max                            their distance to the reference surface
+  inner_rms, inner_p99, inner_share        the vertex scores over the vertices whose closest reference point is
+                                           not on the reference's border (a reference with holes, e.g. a
+                                           scanner's unseen base, has no surface over them: a vertex there
+                                           measures its distance to the hole's rim); inner_share = their share
+  area_rms, area_p99                       the inner scores over an area-uniform sample of the mesh (within
+                                           `delta` of a data point, closest reference point not on its border)
+                                           instead of its vertices: independent of the tessellation (an adaptive
+                                           mesher, e.g. screened Poisson's octree, puts fewer vertices where the
+                                           data are sparse)
   cov_rms, cov_p99, cov_far_share          coverage: a dense area-uniform sample of the reference surface, kept
                                            where the data are (within `delta` of a data point), to the mesh;
                                            cov_far_share = share of those samples farther than `delta` from
@@ -139,6 +148,26 @@ class TriangleDistance:
                 d[i] = min(d[i], self._exact(p[i:i + 1], idx[None, :])[0])
         return d
 
+    def border_distance(self, points):
+        """Exact distance from points to the mesh's border (edges used by one triangle); +inf without a border."""
+        if not hasattr(self, "_border"):
+            e = np.sort(np.concatenate([self.t[:, [0, 1]], self.t[:, [1, 2]], self.t[:, [2, 0]]]), axis=1)
+            edges, counts = np.unique(e, axis=0, return_counts=True)
+            self._border = edges[counts == 1]
+        p = np.asarray(points, dtype=float)
+        out = np.full(len(p), np.inf)
+        if len(self._border) == 0:
+            return out
+        a, b = self.v[self._border[:, 0]], self.v[self._border[:, 1]]
+        ab = b - a
+        len2 = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
+        chunk = max(1, 2000000 // len(ab))  # points x edges x 3 doubles per step: about 50 MB
+        for s in range(0, len(p), chunk):
+            q = p[s:s + chunk, None, :] - a[None, :, :]
+            t = np.clip(np.einsum("ijk,jk->ij", q, ab) / len2[None, :], 0.0, 1.0)
+            out[s:s + chunk] = np.linalg.norm(q - t[:, :, None] * ab[None, :, :], axis=2).min(axis=1)
+        return out
+
     def sample(self, n, rng):
         """n points uniform by area on the mesh."""
         a, b, c = (self.v[self.t[:, j]] for j in range(3))
@@ -210,10 +239,21 @@ def score_mesh(points, triangles, data, reference, delta, cover_samples=200000, 
     result["scored_share"] = float(scored.mean())
     d = reference.distance(v[scored])
     result.update(_stats(d))
+    border = getattr(reference, "border_distance", None)
+    inner = border(v[scored]) > d * (1.0 + 1e-9) + 1e-15 if border else np.ones(len(d), dtype=bool)
+    s = _stats(d[inner], "inner_")
+    result.update(inner_rms=s["inner_rms"], inner_p99=s["inner_p99"],
+                  inner_share=float(inner.mean()) if len(d) else float("nan"))
+    mesh = TriangleDistance(v, t)
+    on_mesh = mesh.sample(cover_samples, np.random.default_rng(seed + 1))
+    on_mesh = on_mesh[np.isfinite(data_tree.query(on_mesh, distance_upper_bound=delta)[0])]
+    da = reference.distance(on_mesh)
+    s = _stats(da[border(on_mesh) > da * (1.0 + 1e-9) + 1e-15] if border else da, "area_")
+    result.update(area_rms=s["area_rms"], area_p99=s["area_p99"])
     rng = np.random.default_rng(seed)
     ref_pts = reference.sample(cover_samples, rng)
     has_data = np.isfinite(data_tree.query(ref_pts, distance_upper_bound=delta)[0])
-    cov = TriangleDistance(v, t).distance(ref_pts[has_data])
+    cov = mesh.distance(ref_pts[has_data])
     s = _stats(cov, "cov_")
     result.update(cov_rms=s["cov_rms"], cov_p99=s["cov_p99"],
                   cov_far_share=float((cov > delta).mean()) if len(cov) else float("nan"))

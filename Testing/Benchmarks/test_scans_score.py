@@ -102,6 +102,50 @@ check(dist.max() < 8 * spec["noise"] * spec["diagonal"], "virtual sphere scan wi
 check(pts[:, 2].min() > -0.95, "virtual sphere scan never sees the bottom (min z %.3f)" % pts[:, 2].min())
 check(spec["views"] == 6 and len(np.unique(view)) == 6, "six views")
 
+# 5b. a reference with a hole, a mesh over all of it lifted by h (uneven: fine in one half, coarse in the other):
+# the inner scores leave out the vertices over the hole (closest reference point on its rim), the area-weighted
+# scores do not depend on where the triangles are small
+def grid_mesh(nx, ny, x0, x1, z=0.0):
+    xs, ys = np.meshgrid(np.linspace(x0, x1, nx), np.linspace(0, 1, ny), indexing="ij")
+    pts = np.stack([xs.ravel(), ys.ravel(), np.full(xs.size, z)], axis=1)
+    idx = np.arange(nx * ny).reshape(nx, ny)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    return pts, np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+
+rp, rt = grid_mesh(21, 21, 0, 1)
+centre = rp[rt].mean(axis=1)
+rt = rt[~((np.abs(centre[:, 0] - 0.5) < 0.2) & (np.abs(centre[:, 1] - 0.5) < 0.2))]  # a 0.4 x 0.4 hole
+reference = S.TriangleDistance(rp, rt)
+h = 0.01
+fine, fine_t = grid_mesh(61, 121, 0, 0.5, h)
+coarse, coarse_t = grid_mesh(6, 11, 0.5, 1, h)
+mp = np.concatenate([fine, coarse])
+mt = np.concatenate([fine_t, coarse_t + len(fine)])
+data = np.stack([rng.uniform(0, 1, 20000), rng.uniform(0, 1, 20000), np.zeros(20000)], axis=1)
+r = S.score_mesh(mp, mt, data, reference, delta=0.05, cover_samples=20000)
+cv = S.clean_mesh(mp, mt)[0]
+on_rim = (np.abs(cv[:, 0] - 0.5) <= 0.2 + 1e-12) & (np.abs(cv[:, 1] - 0.5) <= 0.2 + 1e-12)  # over the hole or its rim
+on_edge = (np.minimum(cv[:, 0], cv[:, 1]) < 1e-12) | (np.maximum(cv[:, 0], cv[:, 1]) > 1 - 1e-12)  # the outer border
+check(r["rms"] > 2 * h, "vertices over the hole measure the rim (rms %.3g > 2 h)" % r["rms"])
+check(abs(r["inner_rms"] - h) < 1e-9 and abs(r["inner_p99"] - h) < 1e-9,
+      "inner scores = the lift h where the reference has surface (%.6g)" % r["inner_rms"])
+check(abs(r["inner_share"] - (1 - (on_rim | on_edge).mean())) < 1e-12,
+      "inner share leaves out the vertices over the hole and the borders (%.4f against %.4f)"
+      % (r["inner_share"], 1 - (on_rim | on_edge).mean()))
+check(abs(r["area_rms"] - h) < 1e-9, "area-weighted inner rms = the lift h (%.6g)" % r["area_rms"])
+flat = S.score_mesh(mp, mt, data, S.TriangleDistance(rp, grid_mesh(21, 21, 0, 1)[1]), delta=0.05, cover_samples=20000)
+check(abs(flat["area_rms"] - h) < 1e-9 and abs(flat["rms"] - h) < 1e-9 and abs(flat["inner_rms"] - h) < 1e-9
+      and abs(flat["inner_share"] - (1 - on_edge.mean())) < 1e-12,
+      "without a hole every score is the lift h, only the outer border left out (%.6g, %.6g, share %.4f)"
+      % (flat["area_rms"], flat["rms"], flat["inner_share"]))
+bumpy = mp.copy()
+bumpy[:len(fine), 2] = 2 * h  # the fine half lifted twice as high: vertex rms weighs it by its vertex count
+b = S.score_mesh(bumpy, mt, data, S.TriangleDistance(rp, grid_mesh(21, 21, 0, 1)[1]), delta=0.05, cover_samples=40000)
+expected_area = np.sqrt(0.5 * (2 * h) ** 2 + 0.5 * h ** 2)
+check(abs(b["area_rms"] - expected_area) < 0.03 * expected_area and b["rms"] > 1.2 * expected_area,
+      "area-weighted rms weighs the halves by area (%.4g against %.4g), the vertex rms by vertices (%.4g)"
+      % (b["area_rms"], expected_area, b["rms"]))
+
 # 6. normal scores: the true normals score 0 degrees; half of them flipped is half consistent
 g = V.Sphere([0, 0, 0], 1).sample(1000, rng)
 r = S.score_normals(g, g)
