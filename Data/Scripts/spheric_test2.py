@@ -15,7 +15,10 @@ tall and 0.99 m wide (column_size() gives it; the CSV header records it and run(
 shifts the reservoir's drain at H4 by about 8 ms (results/spheric2.md). A lattice fitted per axis would need the
 kernels' lattice corrections and the wall dummies' mass redone for it (the kernel sum of a lattice stretched to fit,
 mass from its own volume per particle, is 0.6 % off rho0 at dx = 0.04 and 0.03 m (below, above), 60 times DFSPH's
-density tolerance, with the spiky kernel and h = 2 dx): not done.
+density tolerance, with the spiky kernel and h = 2 dx): not done; nor a half-filled top layer (the right volume and
+head, but a change to how every scene's FluidBounds are filled). Measured in 3D at dx = 0.02 m (results/spheric2.md,
+2026-12-04): 0.54 m against 0.56 m delays the drain at H4 by 12 ms and leaves P1's arrival and peak on the same 10 ms
+samples.
 Gauge labels: the experiment's file cited in Testing/Benchmarks/bench_spheric2.py labels as H1 a gauge that is wet
 from t = 0.185 s (0.07-0.09 m at 0.30-0.38 s) and as H3 one that stays dry (under 1 mm) while H2 fills from 0.350 s:
 its H1 is the gauge at x = 1.488 m and its H3 the one at x = 0.496 m, the reverse of the labels here (checked
