@@ -9,9 +9,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 using meshfree::Index;
@@ -101,6 +103,60 @@ TEST(Parallel, EmptyTinyAndSerialBelow)
   EXPECT_EQ(meshfree::ParallelReduce(
               0, 8, 7.0, [](Index, Index) { return 1.0; }, [](double a, double b) { return a + b; }),
     7.0);
+}
+
+// A loop that runs on the calling thread alone (the fallback when its threads do not pay) is one call over all its
+// items; a loop handed out to the threads is called per range.
+TEST(Parallel, AFallbackIsOneLoopsOwn)
+{
+  ThreadsGuard guard;
+  meshfree::SetMaxThreads(2);
+  const Index n = 64; // grain 1: 64 ranges
+  // A short loop that the threads make slower (another thread's ranges sleep; the caller's take microseconds): it
+  // falls back to the calling thread after a few runs.
+  bool fellBack = false;
+  for (int run = 0; run < 50 && !fellBack; ++run)
+  {
+    meshfree::ParallelFor(n, 1, [&](Index b, Index e) {
+      if (b == 0 && e == n)
+      {
+        fellBack = true;
+      }
+      else if (meshfree::ThreadIndex() != 0)
+      {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+    });
+  }
+  ASSERT_TRUE(fellBack);
+  // Another loop of the same size keeps its threads: it is handed out in ranges.
+  std::atomic<int> calls{ 0 };
+  std::vector<double> values(n, 0.0);
+  meshfree::ParallelFor(n, 1, [&](Index b, Index e) {
+    ++calls;
+    for (Index i = b; i < e; ++i)
+    {
+      values[i] = Busy(i);
+    }
+  });
+  EXPECT_EQ(calls.load(), n);
+  // A long loop (one thread would take over 50 ms) never falls back, even when a range that another thread holds
+  // makes it slower than one thread.
+  for (int run = 0; run < 3; ++run)
+  {
+    std::atomic<int> pieces{ 0 };
+    std::atomic<bool> slept{ false };
+    meshfree::ParallelFor(n, 1, [&](Index b, Index e) {
+      ++pieces;
+      if (meshfree::ThreadIndex() != 0 && !slept.exchange(true))
+      {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(1500 * (e - b))); // ~96 ms on one thread
+    });
+    EXPECT_EQ(pieces.load(), n) << "run " << run;
+  }
 }
 
 TEST(Parallel, ReductionIsTheSameWhateverTheThreads)

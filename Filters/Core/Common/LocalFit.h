@@ -122,6 +122,25 @@ bool RobustDecomposition(
   return true;
 }
 
+namespace detail
+{
+/// The robust path of SolveMoment on the equilibrated M (scales s): Y = S V diag(1 / lambda) V^T S B.
+template <int Q, class MatB, class MatY>
+bool SolveMomentRobust(const Eigen::Matrix<double, Q, Q>& M, const Eigen::Matrix<double, Q, 1>& s, const MatB& B,
+  MatY& Y, double& condition)
+{
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Q, Q>> eig;
+  if (!RobustDecomposition<Q>(M, eig, condition))
+  {
+    return false;
+  }
+  const Eigen::Matrix<double, Q, 1> lambda = eig.eigenvalues();
+  const auto& V = eig.eigenvectors();
+  Y = s.asDiagonal() * (V * (lambda.cwiseInverse().asDiagonal() * (V.transpose() * (s.asDiagonal() * B))));
+  return true;
+}
+} // namespace detail
+
 /**
  * Solves M Y = B for the symmetric positive semi-definite moment matrix M (overwritten), see the file
  * comment. Returns false when M is degenerate (Y untouched). `condition` receives kappa(S M S): exact when
@@ -153,15 +172,108 @@ bool SolveMoment(Eigen::Matrix<double, Q, Q>& M, const MatB& B, MatY& Y, bool ex
       }
     }
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Q, Q>> eig;
-  if (!RobustDecomposition<Q>(M, eig, condition))
+  return detail::SolveMomentRobust<Q>(M, s, B, Y, condition);
+}
+
+/**
+ * The fast path of SolveMomentFast on the equilibrated M~ (Q x Q, symmetric, column-major) with scales s: the
+ * unpivoted LDL^T of M~ (no square roots; one reciprocal per column, so the dependency chain is about half the
+ * Cholesky's), then y = S M~^-1 S b. Its pivots d_j are the Cholesky's L_jj^2 and lie in [lambda_min, lambda_max], so
+ * max d / min d is again a lower bound of kappa(M~). True, with condition = max d / min d, when every pivot is
+ * positive and max d < kFastPathRatio min d; otherwise false, y and condition untouched.
+ */
+template <int Q>
+bool LdltSolve(const double* M, const double* s, const double* b, double* y, double& condition)
+{
+  double L[Q][Q], pivot[Q], inverse[Q];
+  double dmin = 0.0, dmax = 0.0;
+  MESHFREE_UNROLL
+  for (int j = 0; j < Q; ++j)
+  {
+    double w[Q]; // L_jk d_k
+    double d = M[j * Q + j];
+    MESHFREE_UNROLL
+    for (int k = 0; k < j; ++k)
+    {
+      w[k] = L[j][k] * pivot[k];
+      d -= L[j][k] * w[k];
+    }
+    if (!(d > 0.0))
+    {
+      return false;
+    }
+    dmin = (j == 0 || d < dmin) ? d : dmin;
+    dmax = (j == 0 || dmax < d) ? d : dmax;
+    pivot[j] = d;
+    inverse[j] = 1.0 / d;
+    MESHFREE_UNROLL
+    for (int i = j + 1; i < Q; ++i)
+    {
+      double v = M[j * Q + i];
+      MESHFREE_UNROLL
+      for (int k = 0; k < j; ++k)
+      {
+        v -= L[i][k] * w[k];
+      }
+      L[i][j] = v * inverse[j];
+    }
+  }
+  if (!(dmax < kFastPathRatio * dmin))
   {
     return false;
   }
-  const Vector lambda = eig.eigenvalues();
-  const auto& V = eig.eigenvectors();
-  Y = s.asDiagonal() * (V * (lambda.cwiseInverse().asDiagonal() * (V.transpose() * (s.asDiagonal() * B))));
+  condition = dmax / dmin;
+  double z[Q];
+  MESHFREE_UNROLL
+  for (int i = 0; i < Q; ++i)
+  {
+    double v = s[i] * b[i];
+    MESHFREE_UNROLL
+    for (int k = 0; k < i; ++k)
+    {
+      v -= L[i][k] * z[k];
+    }
+    z[i] = v;
+  }
+  MESHFREE_UNROLL
+  for (int i = Q - 1; i >= 0; --i)
+  {
+    double v = z[i] * inverse[i];
+    MESHFREE_UNROLL
+    for (int k = i + 1; k < Q; ++k)
+    {
+      v -= L[k][i] * z[k];
+    }
+    z[i] = v;
+  }
+  MESHFREE_UNROLL
+  for (int i = 0; i < Q; ++i)
+  {
+    y[i] = s[i] * z[i];
+  }
   return true;
+}
+
+/**
+ * SolveMoment (exactCondition off) for one right-hand side with an unpivoted LDL^T (LdltSolve) as the fast path
+ * instead of Eigen's pivoted LDLT: the same equilibration, pivot-ratio test and robust path, the solution equal up to
+ * rounding, in about a third of the time (the normals' 6 x 6 jets: two or three solves per point).
+ */
+template <int Q>
+bool SolveMomentFast(Eigen::Matrix<double, Q, Q>& M, const Eigen::Matrix<double, Q, 1>& B,
+  Eigen::Matrix<double, Q, 1>& Y, double& condition)
+{
+  Eigen::Matrix<double, Q, 1> s;
+  if (!EquilibrationScales<Q>([&M](int i) { return M(i, i); }, s.data(), condition))
+  {
+    return false;
+  }
+  M = s.asDiagonal() * M * s.asDiagonal();
+  if (LdltSolve<Q>(M.data(), s.data(), B.data(), Y.data(), condition))
+  {
+    return true;
+  }
+  return detail::SolveMomentRobust<Q>(M, s, B, Y, condition);
 }
 
 /**

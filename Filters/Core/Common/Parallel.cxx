@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -105,18 +106,27 @@ namespace
 // beside busy processes it can wait for a range that a descheduled thread holds; for short loops (a few
 // milliseconds) that wait can cost more than the other threads bring. Each parallel loop compares its wall time
 // with what the calling thread alone would have taken (its own ranges' time per item, times all the items); when
-// the recent loops of its size (below) ran slower than that, the next 63 of that size run on the calling thread
-// alone, and then the threads are tried again. Results do not depend on this: they never depend on the number of
-// threads.
+// the recent runs of the same loop (below) ran slower than that, its next 63 runs are on the calling thread alone,
+// and then the threads are tried again. Results do not depend on this: they never depend on the number of threads.
 struct LoopHistory
 {
-  double Ratio = 0.0; // moving average of wall time / one-thread estimate; 0: no history
+  RangeFunction Site = nullptr; // the loop: its body's type (one function per ParallelFor instantiation)
+  int SizeClass = -1;           // and its size: the number of ranges handed out, by its power of two
+  double Ratio = 0.0;           // moving average of wall time / one-thread estimate; 0: no history
   int SerialLeft = 0;
 };
-// One history per size class (the number of ranges handed out, by its power of two): a verdict on short loops
-// holds for short loops only.
+// One history per loop and size: a verdict on one loop says nothing about another. (Measured: with one history per
+// size class only, the cheap loops of the normals' crease pass and sample fits, which the workers' wake-up makes
+// slower in parallel, switched the threads off for the jets' loop of the same size; Meshless Normals at 100k and 1M
+// points then ran on one thread beside busy processes. Before, one history for all loops left the whole estimation
+// of a 1M-point cloud on one thread on an idle machine.) Direct-mapped: a loop whose slot another took starts afresh.
+constexpr int kHistorySlots = 256;
 constexpr int kSizeClasses = 64;
-thread_local LoopHistory Histories[kSizeClasses];
+thread_local LoopHistory Histories[kHistorySlots];
+// A loop that one thread would take longer than this never falls back: the threads lose at most the wait for the
+// range a descheduled thread holds (a time slice of the OS scheduler, a few milliseconds), a small part of it, and
+// a wrong verdict would cost 63 runs of a long loop on one thread.
+constexpr double kLongLoopSeconds = 0.05;
 thread_local bool IsCaller = false;
 using Clock = std::chrono::steady_clock;
 
@@ -146,7 +156,12 @@ void ParallelRanges(Index n, Index grain, RangeFunction fn, void* body)
   {
     ++sizeClass;
   }
-  LoopHistory& History = Histories[sizeClass];
+  const std::uintptr_t key = reinterpret_cast<std::uintptr_t>(fn) ^ static_cast<std::uintptr_t>(sizeClass) << 4;
+  LoopHistory& History = Histories[(key ^ key >> 9 ^ key >> 17) % kHistorySlots];
+  if (History.Site != fn || History.SizeClass != sizeClass)
+  {
+    History = LoopHistory{ fn, sizeClass, 0.0, 0 };
+  }
   if (History.SerialLeft > 0)
   {
     --History.SerialLeft;
@@ -181,17 +196,15 @@ void ParallelRanges(Index n, Index grain, RangeFunction fn, void* body)
   });
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   IsCaller = false;
-  // The verdict goes to this loop's size class only: a short loop that the workers' wake-up makes slower in
-  // parallel says nothing about a long one (measured: with one history for all loops, a 16-item loop of the
-  // normals' scale estimate, 3.7 ms, left the whole normal estimation of a 1M-point cloud on one thread, 7.6 s
-  // instead of 4.2 s on 2 idle cores).
   if (ownItems > 0 && ownSeconds > 0.0)
   {
-    const double ratio = wall / (ownSeconds * static_cast<double>(n) / static_cast<double>(ownItems));
+    const double alone = ownSeconds * static_cast<double>(n) / static_cast<double>(ownItems);
+    const double ratio = wall / alone;
     History.Ratio = History.Ratio > 0.0 ? 0.75 * History.Ratio + 0.25 * ratio : ratio;
-    if (History.Ratio > 1.0)
+    if (History.Ratio > 1.0 && alone < kLongLoopSeconds)
     {
-      History = LoopHistory{ 0.0, 63 };
+      History.Ratio = 0.0;
+      History.SerialLeft = 63;
     }
   }
 }

@@ -563,7 +563,7 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
     const Eigen::Matrix<double, 6, 6> moments = M;
     Eigen::Matrix<double, 6, 1> a;
     double condition = 0.0;
-    if (fitted >= 12 && SolveMoment<6>(M, B, a, false, condition) && a.allFinite())
+    if (fitted >= 12 && SolveMomentFast<6>(M, B, a, condition) && a.allFinite())
     {
       jet = true;
       // Residual sum of squares h.h - 2 a.B + a.M a (a.M a = a.B for the exact solution).
@@ -604,7 +604,7 @@ JetFit FitJet(const double* sorted, const Index* pos, size_t count, const double
         D(3) += shq;
         D(5) += shq;
         double conditionC = 0.0;
-        if (SolveMoment<6>(C, D, b, false, conditionC) && b.allFinite())
+        if (SolveMomentFast<6>(C, D, b, conditionC) && b.allFinite())
         {
           const double k = ImplicitMeanCurvature(b.data()) / scale;
           // Along the jet's normal (n - a1 t1 - a2 t2 lies on +h's side).
@@ -674,7 +674,7 @@ bool JetResidual(const double* sorted, const Index* pos, size_t count, const dou
     Eigen::Matrix<double, 6, 1> B, a;
     JetSystem(sums, M, B);
     double condition = 0.0;
-    if (SolveMoment<6>(M, B, a, false, condition) && a.allFinite())
+    if (SolveMomentFast<6>(M, B, a, condition) && a.allFinite())
     {
       residual = std::fabs(a(0)) * scale;
       return true;
