@@ -22,7 +22,8 @@ int main(int argc, char** argv)
 {
   if (argc < 2)
   {
-    std::fprintf(stderr, "usage: %s CLOUD.xyz [--method MLS|WLS] [--fill off|on|auto] [--repeat N] [--out MESH.bin]\n",
+    std::fprintf(stderr, "usage: %s CLOUD.xyz [--method MLS|WLS] [--fill off|on|auto] [--repeat N] [--out MESH.bin]\n"
+                         "  [--support-scale S] [--noise-scale S] [--cell H] [--neighbors K] [--trim SPACINGS]\n",
       argv[0]);
     return 2;
   }
@@ -61,6 +62,10 @@ int main(int argc, char** argv)
     else if (key == "--cell")
     {
       options.CellSize = std::atof(value.c_str());
+    }
+    else if (key == "--trim")
+    {
+      options.TrimSpacings = std::atof(value.c_str()); // 0: an open surface is not trimmed to its data's border
     }
     else if (key == "--neighbors")
     {

@@ -151,8 +151,8 @@ double OnDataRms(const SurfaceMesh& mesh, bool torus, double limit, Index& count
   return std::sqrt(sum / std::max<Index>(count, 1));
 }
 
-/// DistanceToData of the boundary vertices (sorted).
-std::vector<double> BorderDistances(const SurfaceMesh& mesh)
+/// Per vertex: 1 on the mesh's border (an edge of one triangle).
+std::vector<unsigned char> BorderVertices(const SurfaceMesh& mesh)
 {
   std::vector<std::pair<Index, Index>> edges;
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
@@ -178,6 +178,13 @@ std::vector<double> BorderDistances(const SurfaceMesh& mesh)
     }
     i = j;
   }
+  return border;
+}
+
+/// DistanceToData of the boundary vertices (sorted).
+std::vector<double> BorderDistances(const SurfaceMesh& mesh)
+{
+  const std::vector<unsigned char> border = BorderVertices(mesh);
   std::vector<double> d;
   for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
   {
@@ -297,6 +304,49 @@ TEST(SurfaceHoleFilling, SingleViewScanStaysOpenWithoutIslands)
     const std::vector<double> border = BorderDistances(mesh);
     ASSERT_FALSE(border.empty());
     EXPECT_LT(border[border.size() / 2], 2.5 * report.Scale.Spacing) << "torus " << torus;
+  }
+}
+
+TEST(SurfaceHoleFilling, GapsAreBridgedWholeOrOpenedToTheirRim)
+{
+  // A plane with a small round gap, which samples surround within the trimming's limit (bridged: no hole), and two
+  // wedges widening beyond the limit: their narrow parts, within the limit but leading into the wide parts, are
+  // opened too, so the holes' borders run within about a local spacing of their rims all along instead of up to
+  // the limit (2.5 spacings) into their narrow parts (before: 2.76 spacings, the hole along x = 0.5 reaching down
+  // to y = 0.015 only).
+  const double spacing = 0.02;
+  const scan::ScanCloud cloud = scan::GappedPlane(spacing);
+  for (SurfaceMethod method : { SurfaceMethod::MLS, SurfaceMethod::WLS })
+  {
+    SurfaceReport report;
+    const SurfaceMesh mesh = Reconstruct(cloud, HoleFillingMode::Off, report, false, method);
+    ExpectFinite(mesh);
+    const MeshTopology topo = ComputeMeshTopology(mesh.Triangles, mesh.NumberOfPoints());
+    EXPECT_EQ(topo.Components, 1) << SurfaceMethodName(method);
+    EXPECT_EQ(topo.NonManifoldEdges, 0);
+    EXPECT_EQ(topo.EulerCharacteristic, -1) << SurfaceMethodName(method); // two holes: the wedges
+    const std::vector<unsigned char> border = BorderVertices(mesh);
+    double wedgeBorder = 0.0, narrowest = 1.0, roundGap = 1.0;
+    for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
+    {
+      const double* p = &mesh.Points[3 * v];
+      if (!border[v])
+      {
+        continue;
+      }
+      roundGap = std::min(roundGap, std::hypot(p[0] + 0.5, p[1]));
+      const bool along = std::abs(p[0] - 0.5) < 0.3 && std::abs(p[1]) < 0.36;
+      if (along || (p[0] > 0.2 && p[0] < 1.0 && std::abs(p[1] + 0.5) < 0.12))
+      {
+        wedgeBorder = std::max(wedgeBorder, mesh.DistanceToData[v]);
+        narrowest = along ? std::min(narrowest, p[1]) : narrowest;
+      }
+    }
+    EXPECT_LT(wedgeBorder, 1.8 * spacing) << SurfaceMethodName(method);
+    EXPECT_LT(narrowest, -0.08) << SurfaceMethodName(method); // the hole reaches into the wedge's narrow part
+    EXPECT_GT(roundGap, 0.2) << SurfaceMethodName(method); // no border around the round gap: it is covered
+    std::printf("%s: wedge border at most %.2f spacings from the data, down to y = %.3f\n",
+      SurfaceMethodName(method), wedgeBorder / spacing, narrowest);
   }
 }
 

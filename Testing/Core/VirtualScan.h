@@ -139,6 +139,36 @@ inline ScanCloud Scan(bool torus, const std::vector<std::array<double, 3>>& eyes
   return cloud;
 }
 
+/// A patch of the plane z = 0, 2 x 1.4, sampled on a jittered grid of the given spacing (x the longest axis), with
+/// three gaps where the scanner saw nothing: a round one at (-0.5, 0), 1.5 spacings in radius, which samples
+/// surround within the trimming's limit; a wedge along x = 0.5 from y = -0.3 to 0.3 widening from 1 to 10
+/// spacings; and a wedge along y = -0.5 from x = 0.25 to 0.95 widening from 1 to 8 spacings. The wedges' wide ends
+/// lie beyond the limit. Normals +z.
+inline ScanCloud GappedPlane(double spacing, unsigned seed = 5)
+{
+  ScanCloud cloud;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.2 * spacing, 0.2 * spacing);
+  const int nx = static_cast<int>(std::lround(2.0 / spacing)), ny = static_cast<int>(std::lround(1.4 / spacing));
+  for (int j = 0; j <= ny; ++j)
+  {
+    for (int i = 0; i <= nx; ++i)
+    {
+      const double x = -1.0 + i * spacing + jitter(rng), y = -0.7 + j * spacing + jitter(rng);
+      const double along = y > -0.3 && y < 0.3 ? spacing * (0.5 + 4.5 * (y + 0.3) / 0.6) : -1.0;
+      const double across = x > 0.25 && x < 0.95 ? spacing * (0.5 + 3.5 * (x - 0.25) / 0.7) : -1.0;
+      if (std::hypot(x + 0.5, y) < 1.5 * spacing || std::abs(x - 0.5) < along || std::abs(y + 0.5) < across)
+      {
+        continue;
+      }
+      cloud.Points.insert(cloud.Points.end(), { x, y, 0.0 });
+      cloud.Normals.insert(cloud.Normals.end(), { 0.0, 0.0, 1.0 });
+      cloud.View.push_back(0);
+    }
+  }
+  return cloud;
+}
+
 } // namespace testing
 } // namespace meshfree
 

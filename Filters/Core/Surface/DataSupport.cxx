@@ -153,69 +153,6 @@ Index KeepTriangles(TriangleMesh& mesh, const std::vector<unsigned char>& keep, 
   return nt - kept;
 }
 
-std::vector<unsigned char> TrimmedTriangles(const TriangleMesh& mesh, const std::vector<double>& normals,
-  const NeighborGrid& grid, const std::vector<double>& distance, const std::vector<double>& near,
-  const std::vector<double>& limit)
-{
-  const Index nv = mesh.NumberOfPoints();
-  std::vector<unsigned char> on(static_cast<size_t>(nv), 0);
-  struct Buffers
-  {
-    std::vector<Index> Positions;
-    std::vector<double> Dist2;
-  };
-  PerThread<Buffers> buffers;
-  const double* sorted = grid.SortedPoints();
-  ParallelFor(nv, 256, [&](Index begin, Index end) {
-    Buffers& b = buffers.Local();
-    for (Index v = begin; v < end; ++v)
-    {
-      if (distance[v] <= near[v])
-      {
-        on[v] = 1;
-        continue;
-      }
-      if (!(distance[v] <= limit[v]))
-      {
-        continue;
-      }
-      const double* x = &mesh.Points[3 * v];
-      const double* n = &normals[3 * v];
-      grid.FindWithinRadiusPositions(x, 1.5 * limit[v], b.Positions, b.Dist2);
-      double mean[3] = { 0.0, 0.0, 0.0 };
-      Index count = 0;
-      for (size_t j = 0; j < b.Positions.size(); ++j)
-      {
-        const double* p = sorted + 3 * b.Positions[j];
-        double d[3] = { p[0] - x[0], p[1] - x[1], p[2] - x[2] };
-        const double along = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
-        for (int a = 0; a < 3; ++a)
-        {
-          d[a] -= along * n[a];
-        }
-        const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        if (len > 0.0)
-        {
-          for (int a = 0; a < 3; ++a)
-          {
-            mean[a] += d[a] / len;
-          }
-          ++count;
-        }
-      }
-      const double spread = count > 0 ? std::sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]) / count : 1.0;
-      on[v] = spread < OneSided ? 1 : 0;
-    }
-  });
-  const Index nt = mesh.NumberOfTriangles();
-  std::vector<unsigned char> keep(static_cast<size_t>(nt), 1);
-  for (Index t = 0; t < nt; ++t)
-  {
-    keep[t] = on[mesh.Triangles[3 * t]] && on[mesh.Triangles[3 * t + 1]] && on[mesh.Triangles[3 * t + 2]];
-  }
-  return keep;
-}
-
 namespace
 {
 /// Union-find over n nodes; each set is named by its smallest node.
@@ -269,7 +206,177 @@ std::vector<size_t> RecordOrder(const std::vector<double>& all, size_t stride, s
   });
   return order;
 }
+
+/// Gaps the limit bridges only part of the way are opened again (TrimmedTriangles): the vertices kept only because
+/// samples surround them (bridged[v], farther than their near limit) form connected stretches; a stretch that
+/// borders a vertex off the data lies in a gap wider than the limit closes and is dropped with it (on[v] = 0).
+/// Distributed (d; collective): stretches are joined across the processes through their seam vertices (within
+/// `band` of another process' region; the same point on both sides), and a stretch is dropped on every process
+/// when any of its parts borders a vertex off the data.
+void OpenPartlyBridgedGaps(const TriangleMesh& mesh, const std::vector<unsigned char>& bridged,
+  std::vector<unsigned char>& on, const Distribution* d, double band)
+{
+  const Index nv = mesh.NumberOfPoints();
+  Union stretches(nv);
+  std::vector<unsigned char> open(static_cast<size_t>(nv), 0);
+  for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      const Index a = mesh.Triangles[3 * t + c], b = mesh.Triangles[3 * t + (c + 1) % 3];
+      if (bridged[a] && bridged[b])
+      {
+        stretches.Join(a, b);
+      }
+      else if (bridged[a] != bridged[b])
+      {
+        const Index inside = bridged[a] ? a : b, other = bridged[a] ? b : a;
+        open[inside] = open[inside] || !on[other];
+      }
+    }
+  }
+  for (Index v = 0; v < nv; ++v)
+  {
+    if (bridged[v] && open[v])
+    {
+      open[stretches.Find(v)] = 1; // per stretch, on its root
+    }
+  }
+  if (d)
+  {
+    // Nodes: every process' vertices after the earlier processes'; a seam vertex carries its stretch's root and
+    // whether that stretch borders the off-data region here.
+    std::vector<double> counts;
+    d->Gather(std::vector<double>(1, static_cast<double>(nv)), counts);
+    double first = 0.0;
+    for (int r = 0; r < d->Rank(); ++r)
+    {
+      first += counts[r];
+    }
+    std::vector<double> seam;
+    for (Index v = 0; v < nv; ++v)
+    {
+      if (bridged[v] && !d->OwnsBall(&mesh.Points[3 * v], band))
+      {
+        const Index root = stretches.Find(v);
+        seam.insert(seam.end(), &mesh.Points[3 * v], &mesh.Points[3 * v] + 3);
+        seam.push_back(first + static_cast<double>(root));
+        seam.push_back(open[root] ? 1.0 : 0.0);
+      }
+    }
+    std::vector<double> all;
+    d->Gather(seam, all);
+    const size_t n = all.size() / 5;
+    std::vector<double> nodes(n);
+    for (size_t k = 0; k < n; ++k)
+    {
+      nodes[k] = all[5 * k + 3];
+    }
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    const auto node = [&nodes](double id) {
+      return static_cast<Index>(std::lower_bound(nodes.begin(), nodes.end(), id) - nodes.begin());
+    };
+    Union joined(static_cast<Index>(nodes.size()));
+    const std::vector<size_t> byPosition = RecordOrder(all, 5, 3);
+    for (size_t k = 1; k < n; ++k)
+    {
+      const double* a = &all[5 * byPosition[k - 1]];
+      const double* b = &all[5 * byPosition[k]];
+      if (std::equal(a, a + 3, b))
+      {
+        joined.Join(node(a[3]), node(b[3]));
+      }
+    }
+    std::vector<unsigned char> joinedOpen(nodes.size(), 0);
+    for (size_t k = 0; k < n; ++k)
+    {
+      joinedOpen[joined.Find(node(all[5 * k + 3]))] |= all[5 * k + 4] != 0.0 ? 1 : 0;
+    }
+    for (size_t k = 0; k < n; ++k)
+    {
+      const double id = all[5 * k + 3] - first;
+      if (id >= 0.0 && id < static_cast<double>(nv) && joinedOpen[joined.Find(node(all[5 * k + 3]))])
+      {
+        open[static_cast<Index>(id)] = 1;
+      }
+    }
+  }
+  for (Index v = 0; v < nv; ++v)
+  {
+    if (bridged[v] && open[stretches.Find(v)])
+    {
+      on[v] = 0;
+    }
+  }
+}
 } // namespace
+
+std::vector<unsigned char> TrimmedTriangles(const TriangleMesh& mesh, const std::vector<double>& normals,
+  const NeighborGrid& grid, const std::vector<double>& distance, const std::vector<double>& near,
+  const std::vector<double>& limit, const Distribution* d, double band)
+{
+  const Index nv = mesh.NumberOfPoints();
+  std::vector<unsigned char> on(static_cast<size_t>(nv), 0), bridged(static_cast<size_t>(nv), 0);
+  struct Buffers
+  {
+    std::vector<Index> Positions;
+    std::vector<double> Dist2;
+  };
+  PerThread<Buffers> buffers;
+  const double* sorted = grid.SortedPoints();
+  ParallelFor(nv, 256, [&](Index begin, Index end) {
+    Buffers& b = buffers.Local();
+    for (Index v = begin; v < end; ++v)
+    {
+      if (distance[v] <= near[v])
+      {
+        on[v] = 1;
+        continue;
+      }
+      if (!(distance[v] <= limit[v]))
+      {
+        continue;
+      }
+      const double* x = &mesh.Points[3 * v];
+      const double* n = &normals[3 * v];
+      grid.FindWithinRadiusPositions(x, 1.5 * limit[v], b.Positions, b.Dist2);
+      double mean[3] = { 0.0, 0.0, 0.0 };
+      Index count = 0;
+      for (size_t j = 0; j < b.Positions.size(); ++j)
+      {
+        const double* p = sorted + 3 * b.Positions[j];
+        double d[3] = { p[0] - x[0], p[1] - x[1], p[2] - x[2] };
+        const double along = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+        for (int a = 0; a < 3; ++a)
+        {
+          d[a] -= along * n[a];
+        }
+        const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (len > 0.0)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            mean[a] += d[a] / len;
+          }
+          ++count;
+        }
+      }
+      const double spread = count > 0 ? std::sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]) / count : 1.0;
+      on[v] = spread < OneSided ? 1 : 0;
+      bridged[v] = on[v];
+    }
+  });
+  OpenPartlyBridgedGaps(mesh, bridged, on, d, band);
+  const Index nt = mesh.NumberOfTriangles();
+  std::vector<unsigned char> keep(static_cast<size_t>(nt), 1);
+  for (Index t = 0; t < nt; ++t)
+  {
+    keep[t] = on[mesh.Triangles[3 * t]] && on[mesh.Triangles[3 * t + 1]] && on[mesh.Triangles[3 * t + 2]];
+  }
+  return keep;
+}
+
 
 std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const NeighborGrid& grid,
   const std::vector<double>& sampleLimit, Index minimumSamples, Index& pieces, Index& removedPieces,

@@ -47,11 +47,16 @@ Index KeepTriangles(TriangleMesh& mesh, const std::vector<unsigned char>& keep, 
 /// normals[3 v]) lies on the data when distance[v] <= near[v], or when distance[v] <= limit[v] and the samples
 /// within limit[v] surround it: the mean of their unit directions from v, projected on its tangent plane, is
 /// shorter than OneSided (0 for samples all around; 2 / pi = 0.64 on the straight border of a uniform sampling,
-/// towards 1 beyond it). Interior gaps of the sampling are kept, the fringe beyond the border is not.
+/// towards 1 beyond it). Interior gaps of the sampling are kept, the fringe beyond the border is not. A gap the
+/// limit bridges only part of the way (a stretch of vertices kept only as surrounded that borders a vertex off the
+/// data) is opened back to the near limit, so the border runs within one local spacing of the samples instead of
+/// up to the limit into the gap.
+/// Distributed (d; collective): the mesh is a process' part (SparseContour.h); the stretches are the whole mesh's,
+/// joined through the seam vertices within `band` (a lattice cell or more) of another process' region.
 constexpr double OneSided = 0.6;
 std::vector<unsigned char> TrimmedTriangles(const TriangleMesh& mesh, const std::vector<double>& normals,
   const NeighborGrid& grid, const std::vector<double>& distance, const std::vector<double>& near,
-  const std::vector<double>& limit);
+  const std::vector<double>& limit, const Distribution* d = nullptr, double band = 0.0);
 
 /// Triangles to keep: those of pieces (connected through vertices) that at least `minimumSamples` samples
 /// support (the best-supported piece is always kept). A sample (point s of `grid`, limit sampleLimit[s] in the grid's original order) supports the piece

@@ -640,7 +640,8 @@ bool ReconstructSurface(const SurfaceInput& input, const SurfaceOptions& options
         vertexNear[v] = nearest[v] >= 0 ? nearLimit[nearest[v]] : 0.0;
       }
       report.TrimmedTriangles = KeepTriangles(
-        mesh, TrimmedTriangles(mesh, mesh.Normals, grid, mesh.DistanceToData, vertexNear, vertexLimit), attributes);
+        mesh, TrimmedTriangles(mesh, mesh.Normals, grid, mesh.DistanceToData, vertexNear, vertexLimit, d,
+          2.0 * report.CellSize), attributes);
     }
     // (Distributed: every process alike, a part without triangles too - the pieces are the whole mesh's.)
     if (options.RemoveStrayPieces && GlobalSum(d, mesh.NumberOfTriangles()) > 0)

@@ -29,7 +29,8 @@
  * Measured on virtual scans (Testing/Core/VirtualScan.h): four views from 35 degrees above, 0.31 (sphere), 0.43
  * (torus); one view, 0.73 / 0.69; Data/scan_torus.pcd 0.27. Off (or Auto on an open cloud) keeps the fits alone
  * and trims the mesh to the data (DataSupport.h): a vertex stays when it is within one local spacing of a sample
- * (r_k sqrt(pi / k), with 3 sigma of noise), or within TrimSpacings of them and surrounded by samples.
+ * (r_k sqrt(pi / k), with 3 sigma of noise), or within TrimSpacings of them and surrounded by samples (a gap
+ * that limit closes; one it bridges only part of the way is opened back to its rim).
  * Every method gives each vertex its DistanceToData; MLS and WLS drop the pieces fewer than NeighborCount
  * samples support (RemoveStrayPieces).
  */
