@@ -35,7 +35,8 @@ Scores (scans_score.py): delta = 0.4 % of the cloud's bounding-box diagonal (1.1
 data" radius; rms/p99/max over the mesh vertices within delta of a data point, to the reference (inner: without
 those over the reference's holes; area: the same over an area-uniform sample of the mesh); coverage of the
 reference where it has data; boundary edges, pieces, stray triangles, chi; border = p99 distance of the mesh's
-boundary vertices to the nearest data point, in data spacings (open scans: the border should follow the data's).
+boundary vertices to the nearest data point, in median data spacings h and, in parentheses, in the local spacing
+of that data point (r_20 sqrt(pi / 20)) (open scans: the border should follow the data's).
 Writes OUT/scans.md (tables) and OUT/scans_runs.json (every row, the commands, the load averages).
 """
 import argparse
@@ -269,7 +270,14 @@ def spacing(points):
     return float(np.median(d[:, 1]))
 
 
+LOCAL_K = 20  # the local spacing of a sample: r_k sqrt(pi / k) over its k nearest (Meshless Surface's own measure)
+
+
 def border_p99(points, triangles, data_tree, h):
+    """(p99 of the boundary vertices' distance to the nearest data point in median spacings h, p99 of the same
+    distance in the local spacing of that data point); None without a border. A scan's border is where it grazes
+    the surface, 2-8 times sparser than its median: the local figure says how far past the data's own spacing there
+    the surface runs on."""
     v, t, _ = scans_score.clean_mesh(points, triangles)
     if len(t) == 0:
         return None
@@ -278,8 +286,10 @@ def border_p99(points, triangles, data_tree, h):
     b = np.unique(edges[counts == 1])
     if len(b) == 0:
         return None  # no border
-    d, _ = data_tree.query(v[b])
-    return float(np.percentile(d, 99) / h)
+    d, nearest = data_tree.query(v[b])
+    rk, _ = data_tree.query(data_tree.data[nearest], k=LOCAL_K + 1)
+    local = np.maximum(rk[:, -1] * np.sqrt(np.pi / LOCAL_K), 1e-300)
+    return float(np.percentile(d, 99) / h), float(np.percentile(d / local, 99))
 
 
 def distance_to_data_summary(path, delta):
@@ -301,7 +311,8 @@ def score(case, out, ref, delta):
     from scipy.spatial import cKDTree
     pts, tri = scans_score.read_mesh(out)
     row = scans_score.score_mesh(pts, tri, case["points"], ref, delta)
-    row["border_p99_h"] = border_p99(pts, tri, cKDTree(case["points"]), case["spacing"]) if len(tri) else None
+    border = border_p99(pts, tri, cKDTree(case["points"]), case["spacing"]) if len(tri) else None
+    row["border_p99_h"], row["border_p99_local"] = border if border else (None, None)
     extra = distance_to_data_summary(out, delta)
     if extra:
         row.update(extra)
@@ -315,6 +326,13 @@ def fmt(v, f="%.2e"):
     return f % v if isinstance(v, float) else str(v)
 
 
+def border_cell(r):
+    if not r.get("boundary_edges") or r.get("border_p99_h") is None:
+        return "-"
+    local = r.get("border_p99_local")
+    return "%.1f" % r["border_p99_h"] + (" (%.1f)" % local if local is not None else "")
+
+
 def write_report(out, rows, header):
     lines = list(header)
     for case_name in dict.fromkeys(r["case"] for r in rows):
@@ -325,7 +343,7 @@ def write_report(out, rows, header):
                   "%d points, spacing %.2e, delta %.2e; reference: %s." % (c["n"], c["spacing"], c["delta"], c["reference"]),
                   "",
                   "| tool | setting | rms | p99 | max | scored | inner rms | inner p99 | area rms | area p99 | cov rms | "
-                  "cov p99 | cov far | boundary edges | pieces (stray tri.) | chi | border p99 / h | triangles | wall s | "
+                  "cov p99 | cov far | boundary edges | pieces (stray tri.) | chi | border p99 / h (local) | triangles | wall s | "
                   "tool s | peak MB |",
                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in rs:
@@ -338,7 +356,7 @@ def write_report(out, rows, header):
                 fmt(r.get("scored_share"), "%.3f"), fmt(r.get("inner_rms")), fmt(r.get("inner_p99")),
                 fmt(r.get("area_rms")), fmt(r.get("area_p99")), fmt(r.get("cov_rms")), fmt(r.get("cov_p99")),
                 fmt(r.get("cov_far_share"), "%.4f"), fmt(r.get("boundary_edges")), fmt(r.get("pieces")),
-                fmt(r.get("stray_triangles")), fmt(r.get("euler")), fmt(r.get("border_p99_h") if r.get("boundary_edges") else None, "%.1f"),
+                fmt(r.get("stray_triangles")), fmt(r.get("euler")), border_cell(r),
                 fmt(r.get("triangles")), fmt(r.get("wall_s"), "%.1f"), fmt(r.get("algo_s"), "%.1f"),
                 fmt(r.get("peak_mb"), "%.0f")))
         notes = [r for r in rs if r.get("notes")]
@@ -470,7 +488,8 @@ def main():
               "its holes); area: the inner scores over an area-uniform sample of the mesh within delta of the data "
               "instead of its vertices (independent of the tessellation); "
               "cov: reference samples where the data are, to the mesh (far: share farther than delta); border: p99 "
-              "distance of boundary vertices to the data in spacings h; wall s: the whole process(es); tool s: the "
+              "distance of boundary vertices to the data in spacings h (in parentheses: in the local spacing of the "
+              "nearest data point, r_20 sqrt(pi / 20)); wall s: the whole process(es); tool s: the "
               "tool's own algorithm time where it reports one; peak MB: the process's peak resident memory."]
     if a.note:
         header += ["", a.note]
