@@ -207,6 +207,22 @@ std::vector<size_t> RecordOrder(const std::vector<double>& all, size_t stride, s
   return order;
 }
 
+/// Joins the nodes of records (`stride` values each in `all`: a position, then a node of `joined`) that stand at the
+/// same position: the same seam vertex gathered from two processes.
+void JoinSamePositions(const std::vector<double>& all, size_t stride, Union& joined)
+{
+  const std::vector<size_t> byPosition = RecordOrder(all, stride, 3);
+  for (size_t k = 1; k < byPosition.size(); ++k)
+  {
+    const double* a = &all[stride * byPosition[k - 1]];
+    const double* b = &all[stride * byPosition[k]];
+    if (std::equal(a, a + 3, b))
+    {
+      joined.Join(static_cast<Index>(a[3]), static_cast<Index>(b[3]));
+    }
+  }
+}
+
 /// Gaps the limit bridges only part of the way are opened again (TrimmedTriangles): the vertices kept only because
 /// samples surround them (bridged[v], farther than their near limit) form connected stretches; a stretch that
 /// borders a vertex off the data lies in a gap wider than the limit closes and is dropped with it (on[v] = 0).
@@ -217,8 +233,8 @@ void OpenPartlyBridgedGaps(const TriangleMesh& mesh, const std::vector<unsigned 
   std::vector<unsigned char>& on, const Distribution* d, double band)
 {
   const Index nv = mesh.NumberOfPoints();
-  Union stretches(nv);
-  std::vector<unsigned char> open(static_cast<size_t>(nv), 0);
+  Union joinedVertices(nv);
+  std::vector<unsigned char> borders(static_cast<size_t>(nv), 0); // a bridged vertex beside one off the data
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
     for (int c = 0; c < 3; ++c)
@@ -226,85 +242,73 @@ void OpenPartlyBridgedGaps(const TriangleMesh& mesh, const std::vector<unsigned 
       const Index a = mesh.Triangles[3 * t + c], b = mesh.Triangles[3 * t + (c + 1) % 3];
       if (bridged[a] && bridged[b])
       {
-        stretches.Join(a, b);
+        joinedVertices.Join(a, b);
       }
       else if (bridged[a] != bridged[b])
       {
         const Index inside = bridged[a] ? a : b, other = bridged[a] ? b : a;
-        open[inside] = open[inside] || !on[other];
+        borders[inside] = borders[inside] || !on[other];
       }
     }
   }
+  // The stretches numbered in the order of their smallest vertex (a set's name, met first), and whether each
+  // borders the off-data region.
+  std::vector<Index> stretch(static_cast<size_t>(nv), -1);
+  std::vector<unsigned char> open;
   for (Index v = 0; v < nv; ++v)
   {
-    if (bridged[v] && open[v])
+    if (bridged[v])
     {
-      open[stretches.Find(v)] = 1; // per stretch, on its root
+      const Index root = joinedVertices.Find(v);
+      if (root == v)
+      {
+        stretch[v] = static_cast<Index>(open.size());
+        open.push_back(0);
+      }
+      stretch[v] = stretch[root];
+      open[stretch[v]] = open[stretch[v]] || borders[v];
     }
   }
   if (d)
   {
-    // Nodes: every process' vertices after the earlier processes'; a seam vertex carries its stretch's root and
-    // whether that stretch borders the off-data region here.
+    // Every process' stretches after the earlier processes'; a seam vertex carries its stretch and whether that
+    // stretch borders the off-data region there.
     std::vector<double> counts;
-    d->Gather(std::vector<double>(1, static_cast<double>(nv)), counts);
-    double first = 0.0;
-    for (int r = 0; r < d->Rank(); ++r)
+    d->Gather(std::vector<double>(1, static_cast<double>(open.size())), counts);
+    Index first = 0, nodes = 0;
+    for (size_t r = 0; r < counts.size(); ++r)
     {
-      first += counts[r];
+      first += static_cast<int>(r) < d->Rank() ? static_cast<Index>(counts[r]) : 0;
+      nodes += static_cast<Index>(counts[r]);
     }
     std::vector<double> seam;
     for (Index v = 0; v < nv; ++v)
     {
       if (bridged[v] && !d->OwnsBall(&mesh.Points[3 * v], band))
       {
-        const Index root = stretches.Find(v);
         seam.insert(seam.end(), &mesh.Points[3 * v], &mesh.Points[3 * v] + 3);
-        seam.push_back(first + static_cast<double>(root));
-        seam.push_back(open[root] ? 1.0 : 0.0);
+        seam.push_back(static_cast<double>(first + stretch[v]));
+        seam.push_back(open[stretch[v]] ? 1.0 : 0.0);
       }
     }
     std::vector<double> all;
     d->Gather(seam, all);
-    const size_t n = all.size() / 5;
-    std::vector<double> nodes(n);
-    for (size_t k = 0; k < n; ++k)
+    Union joined(nodes);
+    JoinSamePositions(all, 5, joined);
+    std::vector<unsigned char> joinedOpen(static_cast<size_t>(nodes), 0);
+    for (size_t k = 0; k < all.size() / 5; ++k)
     {
-      nodes[k] = all[5 * k + 3];
+      const Index root = joined.Find(static_cast<Index>(all[5 * k + 3]));
+      joinedOpen[root] = joinedOpen[root] || all[5 * k + 4] != 0.0;
     }
-    std::sort(nodes.begin(), nodes.end());
-    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-    const auto node = [&nodes](double id) {
-      return static_cast<Index>(std::lower_bound(nodes.begin(), nodes.end(), id) - nodes.begin());
-    };
-    Union joined(static_cast<Index>(nodes.size()));
-    const std::vector<size_t> byPosition = RecordOrder(all, 5, 3);
-    for (size_t k = 1; k < n; ++k)
+    for (size_t q = 0; q < open.size(); ++q)
     {
-      const double* a = &all[5 * byPosition[k - 1]];
-      const double* b = &all[5 * byPosition[k]];
-      if (std::equal(a, a + 3, b))
-      {
-        joined.Join(node(a[3]), node(b[3]));
-      }
-    }
-    std::vector<unsigned char> joinedOpen(nodes.size(), 0);
-    for (size_t k = 0; k < n; ++k)
-    {
-      joinedOpen[joined.Find(node(all[5 * k + 3]))] |= all[5 * k + 4] != 0.0 ? 1 : 0;
-    }
-    for (size_t k = 0; k < n; ++k)
-    {
-      const double id = all[5 * k + 3] - first;
-      if (id >= 0.0 && id < static_cast<double>(nv) && joinedOpen[joined.Find(node(all[5 * k + 3]))])
-      {
-        open[static_cast<Index>(id)] = 1;
-      }
+      open[q] = open[q] || joinedOpen[joined.Find(first + static_cast<Index>(q))];
     }
   }
   for (Index v = 0; v < nv; ++v)
   {
-    if (bridged[v] && open[stretches.Find(v)])
+    if (bridged[v] && open[stretch[v]])
     {
       on[v] = 0;
     }
@@ -449,17 +453,8 @@ std::vector<unsigned char> SupportedPieces(const TriangleMesh& mesh, const Neigh
     d->Gather(border, all);
     const size_t nb = all.size() / 4;
     // Pieces joined through the seams: the same point on two processes.
-    const std::vector<size_t> byPosition = RecordOrder(all, 4, 3);
     Union joined(nodes);
-    for (size_t k = 1; k < nb; ++k)
-    {
-      const double* a = &all[4 * byPosition[k - 1]];
-      const double* b = &all[4 * byPosition[k]];
-      if (std::equal(a, a + 3, b))
-      {
-        joined.Join(static_cast<Index>(a[3]), static_cast<Index>(b[3]));
-      }
-    }
+    JoinSamePositions(all, 4, joined);
     root.resize(static_cast<size_t>(nodes));
     for (Index q = 0; q < nodes; ++q)
     {
