@@ -7,15 +7,25 @@
  * 1. Blocks: cubes of 4 x the median distance to the NeighborCount-th neighbour (about ten spacings), laid over
  *    the grid's frame (the whole cloud's bounds). Inside each block (blocks in parallel), a minimum spanning tree
  *    of the symmetrised k-nearest graph's edges within the block, cost 1 - |n_i . n_j| (Prim's algorithm with a
- *    bucket queue), grown from the block's first point in the grid's order; every point is flipped to agree with
- *    its tree parent, so orientation travels across the flattest, least ambiguous edges. Each tree is a node.
- * 2. Nodes: every graph edge between two nodes votes n_i . n_j (rounded to 2^-24, so that the votes' sums are
- *    exact in any order); a maximum spanning forest of the summed votes (Kruskal, strongest first, ties by the
+ *    bucket queue), grown from the block's first point in the grid's order, over edges whose normals agree up to
+ *    sign within 30 degrees; every point is flipped to agree with its tree parent, so orientation travels across
+ *    the flattest, least ambiguous edges. Each tree is a node.
+ * 2. Nodes: every graph edge between two nodes votes n_i . n_j - 2 (n_i . e)(n_j . e) / |e|^2, e = p_j - p_i with
+ *    its components along the normals shrunk by the noise (the agreement of two normals on one circular arc
+ *    through both points: n_i . n_j along a gently curved surface, about +1 across a sharp ridge whose faces'
+ *    normals are nearly opposite; NormalOrientation.cxx, ArcAgreement), rounded to 2^-24, so that the votes' sums
+ *    are exact in any order; a maximum spanning forest of the summed votes (Kruskal, strongest first, ties by the
  *    nodes' keys) turns each node relative to its tree's root: the strongest agreement or disagreement decides,
  *    and hundreds of edges vote across a block's face where Prim's single edge could fall on an ambiguous pair.
+ *    Links of fewer than about ten agreeing edges' votes are weak: the strong ones are joined first, and a piece
+ *    they make of at least 2,000 points whose own flux decides its side (an anchor: |sum n . (x - c)| at least a
+ *    quarter of N x its rms radius; not a flat face) is turned on its own (below); the weak links then join the
+ *    rest, never two anchors (a large part of a scan reached only across a sparse strip is not turned by one
+ *    doubtful vote there; a small piece follows its strongest link).
  * Each connected piece (a tree of nodes) is then turned outward as a whole: sum_i n_i . (p_i - c) > 0, c its
  * centroid (by the divergence theorem this is 3 x the enclosed volume for a closed surface, so it is positive
- * exactly when the normals point out; for an open patch it picks the convex side). `Confidence` is
+ * exactly when the normals point out; for an open patch it picks the convex side); a tree holding an anchor as
+ * that anchor's own flux asks. `Confidence` is
  * |n_i . n_parent| (1 for the blocks' roots): below 0.5 the orientation was ambiguous there (research/surface.md
  * §4). Distributed (OrientationOptions::Processes): each process orients the blocks that hold one of its own
  * points (its halo holds the rest of them: Shortfall reports a block beyond it), the nodes' votes and sums are
