@@ -2,6 +2,7 @@
 wrapper) and checks it: exit status 0, no error printed, the PNGs written and not blank-sized. The scripts
 assert on their own data (counts, times, finite values); their failures show here as a non-zero exit."""
 import os
+import random
 import shutil
 import subprocess
 import sys
@@ -16,11 +17,16 @@ def run(name, script, args, expected, folder=FIGURES):
     shutil.rmtree(out, ignore_errors=True)
     cmd = [PVPYTHON, "--no-mpi", os.path.join(folder, script)] + args + ["--out", out]
     env = dict(os.environ)
+    xvfb = shutil.which("xvfb-run")
     for attempt in range(3):
-        result = subprocess.run(cmd, capture_output=True, text=True, cwd=folder, env=env)
+        # A retry gets an X server of its own (the wrapper's display may be the one lost), at a random number.
+        wrap = [xvfb, "-a", "-n", str(100 + random.randrange(800)), "-s", "-screen 0 1280x1024x24"] \
+            if attempt and xvfb else []
+        result = subprocess.run(wrap + cmd, capture_output=True, text=True, cwd=folder, env=env)
         log = result.stdout + result.stderr
-        # On this shared machine another job's Xvfb can race ours for the display: that failure (no
-        # window at all) is retried; every other failure counts.
+        # On this shared machine another job's Xvfb can race ours for the display, or the display can be lost
+        # (fresh-clone CI of 2026-12-04: "bad X server connection" three times on the wrapper's display): that
+        # failure (no window at all) is retried on a new server; every other failure counts.
         if "CreateAWindow" not in log and "bad X server connection" not in log:
             break
         print("X display not available, retrying:", script)
