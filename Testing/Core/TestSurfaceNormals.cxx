@@ -79,6 +79,64 @@ samples::SurfaceCloud SampleCube(std::int64_t n, double sigma, unsigned seed)
   return c;
 }
 
+/// n points uniform by area on a closed triangular prism along y (|y| <= 1): the cross-section an isosceles
+/// triangle with its apex at z = 1 and its base at z = -1, apex angle `apex` (radians), so a ridge that sharp along
+/// the top; Gaussian noise sigma per axis. Normals: the faces'.
+samples::SurfaceCloud SamplePrism(std::int64_t n, double apex, double sigma, unsigned seed)
+{
+  samples::SurfaceCloud c;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double half = 2.0 * std::tan(0.5 * apex); // half the base
+  const double slant = std::sqrt(4.0 + half * half);
+  const double side = 2.0 * slant, base = 4.0 * half, end = 2.0 * half; // areas: a slanted face, the base, an end
+  const double total = 2.0 * side + base + 2.0 * end;
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    const double pick = u(rng) * total;
+    double p[3], m[3] = { 0.0, 0.0, 0.0 };
+    if (pick < 2.0 * side)
+    {
+      const double s = pick < side ? 1.0 : -1.0; // the +x or the -x face
+      const double t = u(rng);                   // 0 at the apex, 1 at the base
+      p[0] = s * half * t;
+      p[1] = 2.0 * u(rng) - 1.0;
+      p[2] = 1.0 - 2.0 * t;
+      m[0] = s * 2.0 / slant;
+      m[2] = half / slant;
+    }
+    else if (pick < 2.0 * side + base)
+    {
+      p[0] = half * (2.0 * u(rng) - 1.0);
+      p[1] = 2.0 * u(rng) - 1.0;
+      p[2] = -1.0;
+      m[2] = -1.0;
+    }
+    else
+    {
+      // An end: uniform in its triangle, corners (0, 1), (-half, -1), (half, -1).
+      double a = u(rng), b = u(rng);
+      if (a + b > 1.0)
+      {
+        a = 1.0 - a;
+        b = 1.0 - b;
+      }
+      const double e = pick < 2.0 * side + base + end ? 1.0 : -1.0;
+      p[0] = half * (b - a);
+      p[1] = e;
+      p[2] = 1.0 - 2.0 * (a + b);
+      m[1] = e;
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      c.Points.push_back(p[a] + sigma * g(rng));
+      c.Normals.push_back(m[a]);
+    }
+  }
+  return c;
+}
+
 /// Angles (degrees) between estimated normal lines and the true normals; 90 where a normal is missing.
 std::vector<double> Angles(const std::vector<double>& normals, const std::vector<double>& truth)
 {
@@ -566,6 +624,33 @@ TEST(SurfaceNormals, ALargePartIsNotTurnedByAStripOfBadNormals)
     }
   }
   EXPECT_EQ(wrong, 0);
+}
+
+TEST(SurfaceNormals, SharpRidgesAreOrientedOutward)
+{
+  // Prisms whose edges are sharper than a cube's: apex 40 and 80 degrees, the faces' normals 140 and 100 degrees
+  // apart along the ridge, 110 and 130 at the base's edges. The propagation inside a block followed edges within
+  // 60 degrees up to sign, and took such a pair for "nearly opposite: turn one face". Measured here: 0.9957 and
+  // 0.9678 outward with 60 degrees, 0.9960 and 0.9961 with 45. (Not yet: with noise, 0.125 % of the diagonal, nodes
+  // at the ridge mix both faces' normal lines and 0.63 / 0.78 are outward; results/scans.md.)
+  for (const double apex : { 40.0, 80.0 })
+  {
+    const samples::SurfaceCloud cloud = SamplePrism(150000, apex * M_PI / 180.0, 0.0, 7);
+    CloudNormalsOptions options;
+    options.ComputeCurvature = false;
+    CloudNormalsResult r;
+    ASSERT_TRUE(ComputeCloudNormals(cloud.Points.data(), cloud.Count(), nullptr, options, r));
+    Index outward = 0;
+    for (Index i = 0; i < cloud.Count(); ++i)
+    {
+      const double* n = &r.Normals[3 * i];
+      const double* t = &cloud.Normals[3 * i];
+      outward += n[0] * t[0] + n[1] * t[1] + n[2] * t[2] > 0.0 ? 1 : 0;
+    }
+    const double share = static_cast<double>(outward) / static_cast<double>(cloud.Count());
+    std::printf("prism, apex %g degrees: outward %.4f\n", apex, share);
+    EXPECT_GT(share, 0.99) << "apex " << apex;
+  }
 }
 
 TEST(SurfaceNormals, CubeEdgesAreNotSmeared)

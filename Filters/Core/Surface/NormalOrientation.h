@@ -8,7 +8,7 @@
  *    the grid's frame (the whole cloud's bounds). Inside each block (blocks in parallel), a minimum spanning tree
  *    of the symmetrised k-nearest graph's edges within the block, cost 1 - |n_i . n_j| (Prim's algorithm with a
  *    bucket queue), grown from the block's first point in the grid's order, over edges whose normals agree up to
- *    sign within 30 degrees; every point is flipped to agree with its tree parent, so orientation travels across
+ *    sign within 45 degrees; every point is flipped to agree with its tree parent, so orientation travels across
  *    the flattest, least ambiguous edges. Each tree is a node.
  * 2. Nodes: every graph edge between two nodes votes n_i . n_j - 2 (n_i . e)(n_j . e) / |e|^2, e = p_j - p_i with
  *    its components along the normals shrunk by the noise (the agreement of two normals on one circular arc
