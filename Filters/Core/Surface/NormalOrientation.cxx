@@ -25,29 +25,6 @@ namespace
 /// and 30; with noise (0.125 % of the diagonal) 0.65 / 0.79 with 60, 0.63 / 0.78 with 45, 0.50 / 0.58 with 30.
 constexpr float kBlockEdgeCost = 0.2928932f; // 1 - cos(45 degrees)
 
-/// How far two normals agree as normals of one smooth surface through their points, for the votes between nodes:
-/// n_j against n_i reflected in the plane that bisects the chord e = p_j - p_i, n_i . n_j - 2 (n_i . e)(n_j . e) /
-/// |e|^2, the relation of two consistently oriented normals on a circular arc through both points (the arc
-/// consistency of König & Gumhold 2009, "Consistent propagation of normal orientations in point clouds"). Along a
-/// gently curved surface (e in the tangent planes) it is n_i . n_j; across a ridge or a part thinner than the
-/// neighbourhood (e across the normals) it is about +1 where n_i . n_j is near -1, so a sharp ridge's faces are not
-/// turned to agree. The components of e along the normals are first shrunk by `noise` (the cloud's spread about the
-/// surface), so that noise and layered views do not read as curvature.
-inline double ArcAgreement(const double* ni, const double* nj, const double* pi, const double* pj, double noise)
-{
-  const double e[3] = { pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2] };
-  const double e2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-  const double c = ni[0] * nj[0] + ni[1] * nj[1] + ni[2] * nj[2];
-  if (!(e2 > 0.0))
-  {
-    return c;
-  }
-  auto shrink = [noise](double a) { return a > noise ? a - noise : (a < -noise ? a + noise : 0.0); };
-  const double a = shrink(ni[0] * e[0] + ni[1] * e[1] + ni[2] * e[2]);
-  const double b = shrink(nj[0] * e[0] + nj[1] * e[1] + nj[2] * e[2]);
-  return c - 2.0 * a * b / e2;
-}
-
 /// Monotone-enough priority queue for Prim's propagation: costs 1 - |cos| in [0, 1] fall into buckets
 /// uniform in sqrt(cost) (about the angle: 1024 buckets, 0.08 degrees each near 0), popped lowest first.
 /// Lowering a key pushes the point again; the caller skips points already taken (lazy deletion). Against a
@@ -90,6 +67,29 @@ private:
 inline double Dot(const double* a, const double* b)
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/// How far two normals agree as normals of one smooth surface through their points, for the votes between nodes:
+/// n_j against n_i reflected in the plane that bisects the chord e = p_j - p_i, n_i . n_j - 2 (n_i . e)(n_j . e) /
+/// |e|^2, the relation of two consistently oriented normals on a circular arc through both points (the arc
+/// consistency of König & Gumhold 2009, "Consistent propagation of normal orientations in point clouds"). Along a
+/// gently curved surface (e in the tangent planes) it is n_i . n_j; across a ridge or a part thinner than the
+/// neighbourhood (e across the normals) it is about +1 where n_i . n_j is near -1, so a sharp ridge's faces are not
+/// turned to agree. The components of e along the normals are first shrunk by `noise` (the cloud's spread about the
+/// surface), so that noise and layered views do not read as curvature.
+inline double ArcAgreement(const double* ni, const double* nj, const double* pi, const double* pj, double noise)
+{
+  const double e[3] = { pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2] };
+  const double e2 = Dot(e, e);
+  const double c = Dot(ni, nj);
+  if (!(e2 > 0.0))
+  {
+    return c;
+  }
+  auto shrink = [noise](double a) { return a > noise ? a - noise : (a < -noise ? a + noise : 0.0); };
+  const double a = shrink(Dot(ni, e));
+  const double b = shrink(Dot(nj, e));
+  return c - 2.0 * a * b / e2;
 }
 
 /// A piece of the orientation: component c of the block with key Block (BlockKey).
@@ -148,16 +148,31 @@ constexpr double VoteScale = 16777216.0;
 constexpr std::int64_t kWeakLink = static_cast<std::int64_t>(10 * VoteScale);
 constexpr double kAnchorPoints = 2000.0;
 
+/// A piece's flux about a centre (relative to the blocks' origin): sum_i n_i . (x_i - c) = sum n.x - c . sum n.
+double FluxAbout(const NodeSums& piece, const double centre[3])
+{
+  return piece[7] - (centre[0] * piece[4] + centre[1] * piece[5] + centre[2] * piece[6]);
+}
+
+/// A piece's centroid (relative to the blocks' origin).
+void Centroid(const NodeSums& piece, double centre[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    centre[a] = piece[1 + a] / std::max(piece[0], 1.0);
+  }
+}
+
 /// Whether a piece's own flux about its centroid, |sum n . (x - c)|, decides its side: at least a quarter of
 /// N x its rms radius (1 for a closed sphere, about 0.6 for half a cylinder as long as wide; a flat face's is its
 /// noise, and such a face, a cube's or a prism's, is no anchor: it follows its links).
 bool OwnFluxDecides(const NodeSums& piece)
 {
+  double c[3];
+  Centroid(piece, c);
   const double count = std::max(piece[0], 1.0);
-  const double c[3] = { piece[1] / count, piece[2] / count, piece[3] / count };
-  const double flux = piece[7] - (c[0] * piece[4] + c[1] * piece[5] + c[2] * piece[6]);
-  const double radius = std::sqrt(std::max(piece[8] / count - (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), 0.0));
-  return std::fabs(flux) >= 0.25 * count * radius;
+  const double radius = std::sqrt(std::max(piece[8] / count - Dot(c, c), 0.0));
+  return std::fabs(FluxAbout(piece, c)) >= 0.25 * count * radius;
 }
 
 /// Union-find with the parity of each element relative to its set's root (Kruskal over the nodes).
@@ -752,14 +767,16 @@ OrientationReport OrientNormals(const NeighborGrid& grid, NormalField& field, co
   // Whether a piece is turned as a whole: outward, or towards the viewpoint.
   auto turnPiece = [&](const NodeSums& piece) {
     double centre[3];
-    for (int a = 0; a < 3; ++a)
+    if (options.Mode == OrientationMode::Viewpoint)
     {
-      centre[a] = options.Mode == OrientationMode::Viewpoint ? options.Viewpoint[a] - blocks.Origin[a]
-                                                             : piece[1 + a] / std::max(piece[0], 1.0);
+      for (int a = 0; a < 3; ++a)
+      {
+        centre[a] = options.Viewpoint[a] - blocks.Origin[a];
+      }
+      return FluxAbout(piece, centre) > 0.0;
     }
-    // sum_i n_i . (x_i - c) = sum n.x - c . sum n
-    const double flux = piece[7] - (centre[0] * piece[4] + centre[1] * piece[5] + centre[2] * piece[6]);
-    return options.Mode == OrientationMode::Viewpoint ? flux > 0.0 : flux < 0.0;
+    Centroid(piece, centre);
+    return FluxAbout(piece, centre) < 0.0;
   };
   sumPieces();
   std::vector<int> anchorTurn(nodes.size(), -1); // per anchor's root after the strong links: its turn
