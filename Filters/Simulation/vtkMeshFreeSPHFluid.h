@@ -209,8 +209,10 @@ public:
    * the CUDA device (the particles stay there for each output interval; see meshfree::SPHFluid::SetBackend)
    * whenever it can: a build with CUDA, a usable device, no obstacles; otherwise a warning with the reason and
    * the CPU result, never an error. Auto chooses the device for jobs of at least GetAutoDeviceParticles()
-   * particles when it can run them (the threshold is a guess until the crossover is measured on a GPU), the
-   * CPU otherwise. The field data array `Backend` (one string) says what ran, e.g. "CPU (oneTBB, 2 threads)" or
+   * particles when it can run them, the CPU otherwise. The threshold was measured on an H200
+   * (Testing/Benchmarks/results/gpu.md): the device won from 2,000 particles (6 times 2 or 16 CPU threads), 24
+   * times 2 threads at 16,000 and 83 times at 65,536, upload and download included; 16,000 leaves room for a
+   * GPU ten times slower. The field data array `Backend` (one string) says what ran, e.g. "CPU (oneTBB, 2 threads)" or
    * "CUDA (NVIDIA H200)". The results do not depend on it (bit for bit): changing it keeps the cached
    * states.
    */
@@ -222,7 +224,7 @@ public:
   };
   vtkSetClampMacro(Backend, int, BACKEND_AUTO, BACKEND_CUDA);
   vtkGetMacro(Backend, int);
-  static vtkIdType GetAutoDeviceParticles() { return 200000; }
+  static vtkIdType GetAutoDeviceParticles() { return 16000; }
   ///@}
 
   /** Number of simulation steps taken by this object since its creation (for tests of the cache). */

@@ -10,7 +10,8 @@
 //
 // BenchSPH --backend cuda [--steps N] [--sizes 65536,1048576,4194304]: the CUDA device integrator
 // (SPHFluid::SetBackend(CUDA)) beside the CPU on 3D dam breaks (double) of 65,536, 1,048,576 and 4,194,304
-// particles (blocks 64x32x32, 128x128x64, 256x128x128 at dx = 1 cm), a fixed step of 1e-4 s: N steps (default
+// particles (blocks 64x32x32, 128x128x64, 256x128x128 at dx = 1 cm; other sizes below 10^6: the 2b x b x b block
+// nearest), a fixed step of 1e-4 s: N steps (default
 // 50; the CPU takes max(2, N / 10) at 1 M particles and more) after 5 warm-up steps, each back end timed over one
 // Advance() call (upload and download included), and whether the final states agree bit for bit (same steps
 // only). Without a usable device it says why and exits 77.
@@ -24,6 +25,7 @@
 #include "cuda/Device.h"
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -89,7 +91,9 @@ int DeviceBenchmark(long steps, const std::vector<long>& sizes)
     "speed-up", "bitwise");
   for (long size : sizes)
   {
-    int b[3] = { 64, 32, 32 };
+    // Below 10^6: a 2b x b x b block with 2 b^3 nearest the size (65,536: 64 x 32 x 32).
+    const int side = std::max(2, static_cast<int>(std::lround(std::cbrt(0.5 * static_cast<double>(size)))));
+    int b[3] = { 2 * side, side, side };
     if (size >= 4000000)
     {
       b[0] = 256;

@@ -6,6 +6,7 @@
 // wherever it does not hand the point back, and hands back every probe of a nearly collinear strip.
 #include "Approximation/Approximation.h"
 #include "Approximation/MLSDevicePoint.h"
+#include "MLSHostViews.h"
 
 #include <gtest/gtest.h>
 
@@ -19,52 +20,15 @@ namespace
 {
 using namespace meshfree;
 
-/// The plain views of a grid (and values), as the device gets them.
-struct Views
-{
-  std::vector<int> Ids;
-  std::vector<double> Values;
-  mls::CloudView Cloud{};
-};
-
-void MakeViews(const NeighborGrid& grid, const std::vector<double>& values, int components, Views& v)
-{
-  const Index nv = grid.NumberOfValidPoints();
-  v.Ids.resize(nv);
-  v.Values.resize(nv * components);
-  for (Index p = 0; p < nv; ++p)
-  {
-    const Index id = grid.SortedOrder()[p];
-    v.Ids[p] = static_cast<int>(id);
-    for (int c = 0; c < components; ++c)
-    {
-      v.Values[p * components + c] = values[id * components + c];
-    }
-  }
-  v.Cloud.Points = grid.SortedPoints();
-  v.Cloud.Ids = v.Ids.data();
-  v.Cloud.Values = v.Values.data();
-  v.Cloud.Cells = reinterpret_cast<const long long*>(grid.Cells());
-  Index dims[3];
-  grid.GetGridDimensions(dims);
-  double bounds[6];
-  grid.GetBounds(bounds);
-  for (int a = 0; a < 3; ++a)
-  {
-    v.Cloud.Dims[a] = dims[a];
-    v.Cloud.Origin[a] = bounds[2 * a];
-  }
-  v.Cloud.Size = grid.CellSize();
-  v.Cloud.InvSize = 1.0 / grid.CellSize();
-  v.Cloud.Components = components;
-}
+using meshfree::testing::HostViews;
+using meshfree::testing::MakeHostViews;
 
 void CheckKNearest(const std::vector<double>& xyz, const std::vector<double>& queries, const std::string& what)
 {
   NeighborGrid grid;
   grid.Build(xyz.data(), static_cast<Index>(xyz.size() / 3));
-  Views v;
-  MakeViews(grid, std::vector<double>(xyz.size() / 3, 0.0), 1, v);
+  HostViews v;
+  MakeHostViews(grid, std::vector<double>(xyz.size() / 3, 0.0), 1, v);
   const Index n = grid.NumberOfValidPoints();
   int compared = 0, gaveUp = 0;
   for (int k : { 1, 7, 20, 64 })
@@ -198,21 +162,9 @@ void CheckPoints(int dim, KernelType weight, bool gradients)
   out.Valid = valid.data();
   a.Evaluate(q.data(), m, out);
 
-  Views v;
-  MakeViews(a.Grid(), values, C, v);
-  mls::FitConstants fc{};
-  fc.K = std::max(o.NeighborCount, kMinimumNeighborsPerTerm * BasisSize(D, M));
-  fc.SupportFactor = o.SupportFactor;
-  fc.WeightKind = static_cast<int>(weight);
-  fc.WeightNormalization = Kernel(weight, D, 1.0).NormalizationFactor();
-  for (int r = 0; r < 3; ++r)
-  {
-    for (int c = 0; c < 3; ++c)
-    {
-      fc.Axes[r][c] = a.Frame3().Axes[r][c];
-    }
-  }
-  fc.Gradients = gradients ? 1 : 0;
+  HostViews v;
+  MakeHostViews(a.Grid(), values, C, v);
+  mls::FitConstants fc = meshfree::testing::MakeFitConstants(a, o, D);
   std::vector<double> dv(C * m, -7.0), dg(3 * C * m, -7.0), conditions(m);
   std::vector<int> dn(m, -1);
   std::vector<unsigned char> needs(m, 0);

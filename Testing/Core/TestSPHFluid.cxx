@@ -222,6 +222,37 @@ TEST(SPHFluid, DeterministicWhateverTheStops)
   EXPECT_EQ(copy.Id, stepped.Id);
 }
 
+// A fixed step below the stable one is taken as given: n steps reach t = n dt, one output landing per interval
+// with no sliver (summing dt n times leaves a remainder of dt plus rounding, which once became two half steps).
+TEST(SPHFluid, FixedStepsLandOnTheirTargets)
+{
+  for (int d : { 2, 3 })
+  {
+    SPHParameters p = FreeBlock(d, SPHKernelPair::Spiky);
+    p.Walls = true;
+    p.Gravity[2] = -9.81;
+    SetBox(p.DomainBounds, { 0.0, 0.2, 0.0, 0.08, 0.0, 0.2 });
+    p.CFLNumber = 0.0;
+    SPHFluid probe;
+    probe.Setup(p);
+    const double stable = probe.StableTimeStep(probe.InitialState(), 0.4);
+    ASSERT_GT(stable, 2e-4);
+    // A decimal step (1e-4 s is not a binary fraction: its sums round) and an arbitrary one.
+    for (double dt : { 1e-4, 0.37 * stable })
+    {
+      p.TimeStep = dt;
+      SPHFluid f;
+      f.Setup(p);
+      SPHState t = f.InitialState();
+      ASSERT_EQ(f.Advance(t, 100 * dt), SPHFluid::Status::Ok);
+      EXPECT_EQ(t.Steps, 100) << d << "D, dt " << dt;
+      ASSERT_EQ(f.Advance(t, 130 * dt), SPHFluid::Status::Ok);
+      EXPECT_EQ(t.Steps, 130) << d << "D, dt " << dt;
+      EXPECT_EQ(f.ReducedSteps(), 0);
+    }
+  }
+}
+
 TEST(SPHFluid, HostileSettings)
 {
   SPHParameters p;

@@ -95,10 +95,11 @@ enum class ApproximationBackend
   CUDA = 2
 };
 
-/// Auto uses the device from this many (evaluation points x neighbours per fit) on: a guess (the first CUDA
-/// call creates a context, tenths of a second; 10^6 such terms take about that long on 2 CPU cores) until
-/// measured on a GPU.
-constexpr double kAutoDeviceWork = 1e6;
+/// Auto uses the device from this many (evaluation points x neighbours per fit) on: 10^4 points at 20 neighbours.
+/// Measured on an H200 (Testing/Benchmarks/results/gpu.md): MLS degree 2 on 10^4 points takes 0.3-0.6 ms on the
+/// device (1 ms with the cloud's upload) against 4-5 ms on 16 CPU threads and 16-27 ms on 2; at 10^3 points both
+/// take about a millisecond. The first device call of a process also creates the context (about 0.1 s), once.
+constexpr double kAutoDeviceWork = 2e5;
 
 /// Method RBF's kernel (ApproximationOptions::RBFKernel).
 enum class RBFKernelType

@@ -16,6 +16,7 @@ namespace
 {
 constexpr double StabilityLambda = 0.4;   // largest CFL factor a fixed step may use before it is reduced
 constexpr Index ParallelThreshold = 4096; // below: one thread (a fork-join would cost more than the work)
+constexpr double kLandingSlack = 1e-9;    // a step this close (relative) to the remaining time lands on the target
 }
 
 void SPHFluid::BuildNeighborLists(const SPHState& state, bool withBoundary)
@@ -361,7 +362,9 @@ bool SPHFluid::LandStep(double time, double targetTime, long steps, double& dt, 
     return false;
   }
   last = false;
-  if (dt >= remaining)
+  // A remainder within rounding of the step is the last step: n fixed steps of dt summed to t + n dt leave a
+  // remainder of dt plus a few ulps, which must not become two half steps (kLandingSlack, relative).
+  if (dt >= remaining * (1.0 - kLandingSlack))
   {
     dt = remaining;
     last = true;
