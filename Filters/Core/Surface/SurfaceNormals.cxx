@@ -40,6 +40,10 @@ constexpr size_t FramePoints = 64; // the jet's frame (its PCA) from this many o
 // FlagFloor x its radius reaches across a crease.
 constexpr double FlagMisfit = 1.25;
 constexpr double FlagFloor = 0.01;
+// A single point's jet is flagged from FlagSignificance standard errors of its misfit above the noise on (the rms
+// of n fitted points scatters by about 1 / sqrt(2 n), relative), where that is below FlagMisfit: a 256-point jet
+// from 1.155 x the noise.
+constexpr double FlagSignificance = 3.5;
 constexpr double MaxCrossing = 0.2;
 constexpr double NoiseAgreement = 1.5; // the jets' noise at most this many times the PCA spread's (thin parts)
 constexpr double MaxTurn = 0.2; // radians: the most the curvature may turn the normal between a point and its donor
@@ -888,7 +892,8 @@ bool NearestOfList(const double* sorted, const Index* pos, const double* r2, siz
 
 /// Sharp features. A jet whose neighbourhood reaches across a crease (a cube's edge or corner) misfits its
 /// neighbours far beyond the noise and smears the normal. Such a point (misfit over FlagMisfit x the cloud's
-/// noise and over FlagFloor x its radius) takes the normal of the neighbour, within its radius, whose jet
+/// noise, or fewer standard errors of a large fit's misfit: FlagSignificance, and over FlagFloor x its radius)
+/// takes the normal of the neighbour, within its radius, whose jet
 /// fits with the smallest misfit (at most 1 / FlagMisfit of its own) among those whose jet passes through the
 /// point (within 3 x max(noise, that jet's misfit) of its tangent plane, plus the curvature's sag): the
 /// neighbourhood that lies on the point's side of the crease. Only neighbours within MaxTurn / the median
@@ -927,8 +932,14 @@ void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vect
     const double sag = 0.5 * field.Scale.Curvature * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     return std::fabs(along(j, y) - height[j]) - (3.0 * std::max(noise, rms[j]) + sag);
   };
+  // The points the jet fits at radius r: pi r^2 / spacing^2, at most MaxFit (FitJet's spread subset).
+  const double perArea = field.Scale.Spacing > 0.0 ? Pi / (field.Scale.Spacing * field.Scale.Spacing) : 0.0;
   auto flagged = [&](Index j) {
-    return rms[j] > FlagMisfit * noise && rms[j] > FlagFloor * field.Radii[order[j]];
+    const double r = field.Radii[order[j]];
+    const double fitted = std::min(static_cast<double>(MaxFit), perArea * r * r);
+    const double limit = fitted > 1.0 ? std::min(FlagMisfit, 1.0 + FlagSignificance / std::sqrt(2.0 * fitted))
+                                      : FlagMisfit;
+    return rms[j] > limit * noise && rms[j] > FlagFloor * r;
   };
   ParallelFor(nv, 256, [&](Index b0, Index b1) {
     Buffers& mine = buffers.Local();
