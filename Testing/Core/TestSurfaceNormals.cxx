@@ -626,11 +626,14 @@ TEST(SurfaceNormals, SharpRidgesAreOrientedOutward)
   // Prisms whose edges are sharper than a cube's: apex 40 and 80 degrees, the faces' normals 140 and 100 degrees
   // apart along the ridge, 110 and 130 at the base's edges. The propagation inside a block followed edges within
   // 60 degrees up to sign, and took such a pair for "nearly opposite: turn one face". Measured here: 0.9957 and
-  // 0.9678 outward with 60 degrees, 0.9960 and 0.9961 with 45. (Not yet: with noise, 0.125 % of the diagonal, nodes
-  // at the ridge mix both faces' normal lines and 0.63 / 0.78 are outward; results/scans.md.)
+  // 0.9678 outward with 60 degrees, 0.9960 and 0.9961 with 45. With noise (0.125 % of the diagonal) the points
+  // near a ridge take a neighbour's normal (SharpFeatures), often the other face's, and propagating over those
+  // tied the faces wrongly: 0.63 / 0.78 outward; since the jets' own normals are oriented and the donors' follow
+  // them, 0.950 / 0.970.
+  for (const double level : { 0.0, 0.00125 })
   for (const double apex : { 40.0, 80.0 })
   {
-    const samples::SurfaceCloud cloud = SamplePrism(150000, apex * M_PI / 180.0, 0.0, 7);
+    const samples::SurfaceCloud cloud = SamplePrism(150000, apex * M_PI / 180.0, level * 2.0 * std::sqrt(3.0), 7);
     CloudNormalsOptions options;
     options.ComputeCurvature = false;
     CloudNormalsResult r;
@@ -643,8 +646,8 @@ TEST(SurfaceNormals, SharpRidgesAreOrientedOutward)
       outward += n[0] * t[0] + n[1] * t[1] + n[2] * t[2] > 0.0 ? 1 : 0;
     }
     const double share = static_cast<double>(outward) / static_cast<double>(cloud.Count());
-    std::printf("prism, apex %g degrees: outward %.4f\n", apex, share);
-    EXPECT_GT(share, 0.99) << "apex " << apex;
+    std::printf("prism, apex %g degrees, noise %g: outward %.4f\n", apex, level, share);
+    EXPECT_GT(share, level > 0.0 ? 0.93 : 0.99) << "apex " << apex << ", noise " << level;
   }
 }
 

@@ -31,6 +31,10 @@
  * points (its halo holds the rest of them: Shortfall reports a block beyond it), the nodes' votes and sums are
  * gathered (a few values per block), and every process solves the same node forest. Only the pieces' flux
  * sums (decisions on their sign) depend on the summation order.
+ * Sharp features (NormalField::JetNormals, SurfaceNormals.cxx's SharpFeatures): where points near a crease took a
+ * neighbour's normal, the propagation runs over the jets' own normals (a donor near a ridge is often the other
+ * face's, and propagating over it tied the faces wrongly), then each donor normal is turned to agree with its
+ * point's oriented one.
  * Viewpoint: every component is turned towards a viewpoint as a whole (sum_i n_i . (v - p_i) > 0); the
  * propagation still decides within it, so non-star-shaped objects stay consistent.
  * Reference: each normal is flipped to agree with a given normal (e.g. a scan's normals of poor quality or

@@ -115,6 +115,10 @@ struct NormalField
                                         // the point's sphere-exact jet, 1 / length, positive where the surface
                                         // bends away from Normals as estimated (before OrientNormals); 0 if none
   std::vector<double> Residual;         // distance from the point to its neighbours' jet (at max(r_k, Radius))
+  std::vector<double> JetNormals;       // 3 per point where a sharp feature gave some point a neighbour's normal
+                                        // (Normals holds that donor's): every point's own jet normal; else empty.
+                                        // OrientNormals propagates over these and then turns each donor normal
+                                        // to agree with its point's, and frees them
   std::vector<unsigned char> Outlier;   // residual > max(6 x median residual, 5 % of r_k): left out of fits
   std::vector<unsigned char> Valid;
   detail::Buffer<std::int32_t> Graph;   // GraphDegree nearest other points per point (-1 pads)
