@@ -1,5 +1,6 @@
 // Clouds sampled from analytic surfaces, shared by the surface-reconstruction and normals tests: uniform by
-// area on the unit sphere and on the torus R = 1, r = 0.35 (axis z), isotropic Gaussian noise, exact normals.
+// area on the unit sphere and on the torus R = 1, r = 0.35 (axis z), and on the cube [-1, 1]^3, isotropic Gaussian
+// noise, exact normals.
 #ifndef meshfree_SurfaceSamples_h
 #define meshfree_SurfaceSamples_h
 
@@ -65,6 +66,27 @@ inline SurfaceCloud SampleSurface(bool torus, std::int64_t n, double sigma, unsi
     {
       c.Points.push_back(p[a] + sigma * g(rng));
       c.Normals.push_back(m[a]);
+    }
+  }
+  return c;
+}
+
+/// n points uniform by area on the cube [-1, 1]^3, Gaussian noise sigma per axis; Normals: the face's.
+inline SurfaceCloud SampleCube(std::int64_t n, double sigma, unsigned seed)
+{
+  SurfaceCloud c;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    const int face = static_cast<int>(rng() % 6);
+    double p[3] = { u(rng), u(rng), u(rng) };
+    p[face / 2] = face % 2 ? -1.0 : 1.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      c.Points.push_back(p[a] + sigma * g(rng));
+      c.Normals.push_back(a == face / 2 ? p[a] : 0.0);
     }
   }
   return c;

@@ -245,6 +245,14 @@ TEST_F(DistributedNormals, ThinnedWideJetsOnThreeSlabsAreTheSerialRun)
   ExpectSameAsSerial(cloud.Points, CloudNormalsOptions(), 3, 1.0);
 }
 
+TEST_F(DistributedNormals, SharpEdgesOnThreeSlabsAreTheSerialRun)
+{
+  // A noisy cube: points near its edges take a neighbour's normal (SurfaceNormals.cxx, SharpFeatures), the jets'
+  // own normals are oriented and the donors' follow them (NormalOrientation.h), on every process alike.
+  const samples::SurfaceCloud cloud = samples::SampleCube(20000, 0.02, 9);
+  ExpectSameAsSerial(cloud.Points, CloudNormalsOptions(), 3, 1.0);
+}
+
 TEST_F(DistributedNormals, ProjectionAndViewpointOnFourSlabs)
 {
   const samples::SurfaceCloud cloud = samples::SampleSurface(false, 8000, 0.003, 5);

@@ -58,26 +58,7 @@ NormalScore Score(const samples::SurfaceCloud& cloud, const std::vector<double>&
   return s;
 }
 
-/// n points uniform by area on the cube [-1, 1]^3, Gaussian noise sigma per axis; Normals: the face's.
-samples::SurfaceCloud SampleCube(std::int64_t n, double sigma, unsigned seed)
-{
-  samples::SurfaceCloud c;
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> g;
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (std::int64_t i = 0; i < n; ++i)
-  {
-    const int face = static_cast<int>(rng() % 6);
-    double p[3] = { u(rng), u(rng), u(rng) };
-    p[face / 2] = face % 2 ? -1.0 : 1.0;
-    for (int a = 0; a < 3; ++a)
-    {
-      c.Points.push_back(p[a] + sigma * g(rng));
-      c.Normals.push_back(a == face / 2 ? p[a] : 0.0);
-    }
-  }
-  return c;
-}
+using samples::SampleCube;
 
 /// n points uniform by area on a closed triangular prism along y (|y| <= 1): the cross-section an isosceles
 /// triangle with its apex at z = 1 and its base at z = -1, apex angle `apex` (radians), so a ridge that sharp along
