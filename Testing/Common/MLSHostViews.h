@@ -74,6 +74,26 @@ inline mls::FitConstants MakeFitConstants(const Approximator& a, const Approxima
   return fc;
 }
 
+/// Runs the device's per-point code on the host for the m probes q (3 each), component group by group as the kernel
+/// does, into `out`; out.NeedsCPU[t] is set to 1 where it refused point t (the points the device hands back) and
+/// left as it was elsewhere.
+template <int D, int M>
+void RunHostPoints(const mls::CloudView& cloud, mls::FitConstants fc, const double* q, int m, const mls::OutputView& out)
+{
+  for (int c0 = 0; c0 < cloud.Components; c0 += mls::kComponentGroup)
+  {
+    fc.FirstComponent = c0;
+    fc.GroupComponents = std::min(mls::kComponentGroup, cloud.Components - c0);
+    for (int t = 0; t < m; ++t)
+    {
+      if (!mls::MLSFast<D, M>(cloud, fc, &q[3 * t], t, out))
+      {
+        out.NeedsCPU[t] = 1;
+      }
+    }
+  }
+}
+
 } // namespace testing
 } // namespace meshfree
 

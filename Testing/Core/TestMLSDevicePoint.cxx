@@ -169,18 +169,7 @@ void CheckPoints(int dim, KernelType weight, bool gradients)
   std::vector<int> dn(m, -1);
   std::vector<unsigned char> needs(m, 0);
   mls::OutputView ov{ dv.data(), dg.data(), dn.data(), conditions.data(), needs.data() };
-  for (int c0 = 0; c0 < C; c0 += mls::kComponentGroup)
-  {
-    fc.FirstComponent = c0;
-    fc.GroupComponents = std::min(mls::kComponentGroup, C - c0);
-    for (int t = 0; t < m; ++t)
-    {
-      if (!mls::MLSFast<D, M>(v.Cloud, fc, &q[3 * t], t, ov))
-      {
-        needs[t] = 1;
-      }
-    }
-  }
+  meshfree::testing::RunHostPoints<D, M>(v.Cloud, fc, q.data(), m, ov);
   int handed = 0, strip = 0, differ = 0;
   for (int t = 0; t < m; ++t)
   {

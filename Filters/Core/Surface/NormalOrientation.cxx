@@ -331,10 +331,7 @@ void ReduceVotes(const Distribution* d, std::vector<std::tuple<Node, Node, std::
   }
   SumVotes(votes, links, false);
 }
-} // namespace
 
-namespace
-{
 /// OrientNormals over field.Normals as they are.
 OrientationReport OrientGivenNormals(const NeighborGrid& grid, NormalField& field, const OrientationOptions& options,
   std::vector<double>& confidence)

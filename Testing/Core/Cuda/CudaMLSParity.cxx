@@ -43,23 +43,15 @@ bool SameBits(const double* a, const double* b, size_t n)
 /// Which of the m probes the device's per-point code (MESHFREE_HD), run here on the host, refuses: the points the
 /// device must hand back.
 template <int D, int M>
-std::vector<unsigned char> HostRefusals(const mls::CloudView& cloud, mls::FitConstants fc, const std::vector<double>& q)
+std::vector<unsigned char> HostRefusals(const mls::CloudView& cloud, const mls::FitConstants& fc, const std::vector<double>& q)
 {
   const int m = static_cast<int>(q.size() / 3);
   const int C = cloud.Components;
   std::vector<double> v(C * m), g(3 * C * m), conditions(m);
   std::vector<int> n(m);
   std::vector<unsigned char> needs(m, 0);
-  const mls::OutputView ov{ v.data(), g.data(), n.data(), conditions.data(), needs.data() };
-  for (int c0 = 0; c0 < C; c0 += mls::kComponentGroup)
-  {
-    fc.FirstComponent = c0;
-    fc.GroupComponents = std::min(mls::kComponentGroup, C - c0);
-    for (int t = 0; t < m; ++t)
-    {
-      needs[t] = mls::MLSFast<D, M>(cloud, fc, &q[3 * t], t, ov) ? needs[t] : 1;
-    }
-  }
+  testing::RunHostPoints<D, M>(cloud, fc, q.data(), m,
+    mls::OutputView{ v.data(), g.data(), n.data(), conditions.data(), needs.data() });
   return needs;
 }
 
