@@ -58,7 +58,8 @@ case "${1:-}" in
     # One X server for all scripts (starting one per script races with other Xvfb users on busy machines).
     xvfb-run -a -n $((100 + RANDOM % 800)) -s "-screen 0 1280x1024x24" bash -euo pipefail -c '
       for script in demo.py figures/fig_3_x_approximation.py figures/fig_3_5_random256.py \
-                    figures/fig_4_x_deformable.py figures/fig_5_8_sph.py demo_solid.py demo_scan.py demo_dambreak.py; do
+                    figures/fig_4_x_deformable.py figures/fig_5_8_sph.py demo_solid.py demo_scan.py demo_dambreak.py \
+                    demo_spheric2.py; do
         echo "-- $script"
         pvpython --no-mpi "$1/Data/Scripts/$script" --out "$2"
       done' demo "$here" "$out"

@@ -5,6 +5,10 @@ Called by ./run.sh demo, or on its own:
 Data/scan_torus.pcd is a torus seen by four scanners (3,000 points, noise along the rays, an intensity per point;
 the scanners never saw a band at the bottom of the inner side). Pictures:
   scan_points.png    the cloud with its estimated, outward normals as glyphs, coloured by intensity
+  scan_holes.png     seen from below, the default MLS surface with HoleFilling 'Auto' (left: closed, one piece)
+                     beside HoleFilling 'Off' (right: open where the scanners saw nothing), both coloured by
+                     DistanceToData (0 on the data, growing across the filled band: a Threshold on it cuts the
+                     filled part away).
   scan_surface.png   the surface (normals estimated from the points alone), coloured by the scan's intensity
                      approximated onto its vertices. The band the scanners never saw is wider than the default
                      support (2 x the distance to the 20th neighbour); HoleFilling (Auto, the default: the cloud
@@ -45,8 +49,42 @@ def intensity_colours(display, view, title):
     bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
 
 
+def holes(cloud, out, size):
+    """out/scan_holes.png: the default MLS surface filled and not, side by side, seen from below."""
+    filled = MeshlessSurface(Input=cloud, HoleFilling="Auto")  # noqa: F821
+    open_ = MeshlessSurface(Input=cloud, HoleFilling="Off")  # noqa: F821
+    beside = simple.Transform(Input=open_)
+    beside.Transform.Translate = [2.9, 0.0, 0.0]
+    view = new_view(size)
+    lut = simple.GetColorTransferFunction("DistanceToData")
+    lut.ApplyPreset("Inferno (matplotlib)", True)
+    for source in (filled, beside):
+        display = simple.Show(source, view)
+        simple.ColorBy(display, ("POINTS", "DistanceToData"))
+        display.Specular = 0.2
+    lut.AutomaticRescaleRangeMode = "Never"
+    lut.RescaleTransferFunction(0.0, 0.15)
+    display.SetScalarBarVisibility(view, True)
+    bar = simple.GetScalarBar(lut, view)
+    bar.Title = "DistanceToData"
+    bar.ComponentTitle = ""
+    bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
+    bar.WindowLocation = "Upper Left Corner"
+    view.CameraPosition = [1.45, -2.5, -3.0]
+    view.CameraFocalPoint = [1.45, 0.0, 0.0]
+    view.CameraViewUp = [0, 0, 1]
+    simple.SetActiveView(view)
+    simple.ResetCamera(view)
+    simple.GetActiveCamera().Dolly(1.5)
+    simple.Render(view)
+    path = os.path.join(out, "scan_holes.png")
+    simple.SaveScreenshot(path, view, ImageResolution=list(size))
+    simple.Delete(view)
+    return path
+
+
 def scan_surface(out, size=(900, 600)):
-    """Writes out/scan_points.png and out/scan_surface.png; returns their paths."""
+    """Writes out/scan_points.png, out/scan_holes.png and out/scan_surface.png; returns their paths."""
     if "MeshlessSurface" not in globals():
         load_plugin(globals())
     cloud = simple.OpenDataFile(os.path.join(HERE, "..", "scan_torus.pcd"))
@@ -76,6 +114,8 @@ def scan_surface(out, size=(900, 600)):
     paths.append(os.path.join(out, "scan_points.png"))
     simple.SaveScreenshot(paths[-1], view, ImageResolution=list(size))
     simple.Delete(view)
+
+    paths.append(holes(cloud, out, (1200, 540)))
 
     view = new_view(size)
     mesh = simple.Show(surface, view)

@@ -29,8 +29,11 @@ PANELS = [
 
 SURFACE_PANELS = [
     ("scan_points.png", "scan: 3,000 points, estimated outward normals"),
+    ("scan_holes.png", "from below: HoleFilling Auto / Off, coloured by DistanceToData"),
     ("scan_surface.png", "its surface, coloured by the scan's intensity"),
     ("dambreak_surface_005.png", "3D dam break as an SPH surface, coloured by speed"),
+    ("spheric2_001.png", "SPHERIC Test 2 (DFSPH, dx 0.05 m) at 0.5 s"),
+    ("spheric2_003.png", "... at 1 s"),
 ]
 
 
@@ -54,7 +57,7 @@ def main():
     demo = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build", "demo")
     out = sys.argv[2] if len(sys.argv) > 2 else os.path.join(here, "results", "demo_figures.png")
     montage(demo, PANELS, out, 2, 5, (15, 5.4))
-    montage(demo, SURFACE_PANELS, os.path.join(os.path.dirname(out), "surface_figures.png"), 1, 3, (15, 3.6))
+    montage(demo, SURFACE_PANELS, os.path.join(os.path.dirname(out), "surface_figures.png"), 2, 3, (15, 7.2))
 
 
 if __name__ == "__main__":

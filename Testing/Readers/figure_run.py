@@ -12,7 +12,8 @@ FIGURES = os.path.join(source, "Data", "Scripts", "figures")
 PVPYTHON = shutil.which("pvpython") or sys.executable
 
 
-def run(name, script, args, expected, folder=FIGURES):
+def run(name, script, args, expected, folder=FIGURES, expected_warnings=()):
+    """expected_warnings: parts of warnings the script provokes on purpose (each must appear; others fail)."""
     out = os.path.join(os.environ["MESHFREE_TEST_OUTPUT"], "figures_" + name)
     shutil.rmtree(out, ignore_errors=True)
     cmd = [PVPYTHON, "--no-mpi", os.path.join(folder, script)] + args + ["--out", out]
@@ -33,9 +34,12 @@ def run(name, script, args, expected, folder=FIGURES):
     print(result.stdout)
     # ParaView's own Python-plugin import error (getargspec, Python 3.11) is noise; our errors are not.
     problems = [l for l in log.splitlines() if ("ERR|" in l or "Error" in l or "WARN|" in l)
-                and "getargspec" not in l and "openpmd" not in l and "savgreader" not in l]
+                and "getargspec" not in l and "openpmd" not in l and "savgreader" not in l
+                and not any(w in l for w in expected_warnings)]
     assert result.returncode == 0, log
     assert not problems, "\n".join(problems)
+    for w in expected_warnings:
+        assert w in log, "expected warning not printed: " + w
     for png in expected:
         path = os.path.join(out, png)
         assert os.path.exists(path) and os.path.getsize(path) > 10000, path
