@@ -1,4 +1,5 @@
-"""What the demo scripts share (demo_scan.py, demo_dambreak.py): the plugin and a white render view."""
+"""What the demo scripts share (demo_scan.py, demo_dambreak.py, demo_spheric2.py): the plugin, a white render view,
+scalar bars that read on it, colouring by speed, and frames saved over time."""
 import os
 import sys
 
@@ -24,3 +25,38 @@ def new_view(size):
     except AttributeError:
         pass
     return view
+
+
+def black_scalar_bar(lut, view, title, component=""):
+    """The scalar bar of `lut` in `view` with black title and labels (the default white is invisible on white)."""
+    bar = simple.GetScalarBar(lut, view)
+    bar.Title = title
+    bar.ComponentTitle = component
+    bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
+    return bar
+
+
+def speed_colours(display, view, maximum):
+    """Colours `display` by the magnitude of Velocity (Jet, 0 to `maximum` m/s) with its bar; returns the bar."""
+    simple.ColorBy(display, ("POINTS", "Velocity", "Magnitude"))
+    lut = simple.GetColorTransferFunction("Velocity")
+    lut.ApplyPreset("Jet", True)
+    lut.RescaleTransferFunction(0.0, maximum)
+    display.SetScalarBarVisibility(view, True)
+    bar = black_scalar_bar(lut, view, "speed", "(m/s)")
+    bar.TitleFontSize = 18
+    bar.LabelFontSize = 16
+    bar.RangeLabelFormat = "%-#.1f"
+    return bar
+
+
+def save_frames(view, times, out, pattern, size):
+    """Renders `view` at each of `times` into out/(pattern % k); returns the paths."""
+    paths = []
+    for k, t in enumerate(times):
+        view.ViewTime = t
+        simple.Render(view)
+        path = os.path.join(out, pattern % k)
+        simple.SaveScreenshot(path, view, ImageResolution=list(size))
+        paths.append(path)
+    return paths

@@ -12,7 +12,7 @@ import os
 
 from paraview import simple
 
-from demo_common import load_plugin, new_view
+from demo_common import load_plugin, new_view, save_frames, speed_colours
 
 
 def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
@@ -32,18 +32,7 @@ def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
     display = simple.Show(fluid, view)
     display.SetRepresentationType("Points")
     display.PointSize = 3
-    simple.ColorBy(display, ("POINTS", "Velocity", "Magnitude"))
-    lut = simple.GetColorTransferFunction("Velocity")
-    lut.ApplyPreset("Jet", True)
-    lut.RescaleTransferFunction(0.0, 3.0)
-    display.SetScalarBarVisibility(view, True)
-    # The default scalar bar text is white: invisible on the white background. Black title and labels.
-    bar = simple.GetScalarBar(lut, view)
-    bar.Title = "speed"
-    bar.ComponentTitle = "(m/s)"
-    bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
-    bar.TitleFontSize = 18
-    bar.LabelFontSize = 16
+    bar = speed_colours(display, view, 3.0)
     bar.DrawTickLabels = 1
     bar.AddRangeLabels = 1
     bar.RangeLabelFormat = "%-#.1f"
@@ -54,25 +43,14 @@ def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
     view.CameraPosition = [0.8, -1.5, 0.8]
     view.CameraFocalPoint = [0.8, 0.16, 0.12]
     view.CameraViewUp = [0, 0, 1]
-    paths = []
-    for k, t in enumerate(fluid.TimestepValues):
-        view.ViewTime = t
-        simple.Render(view)
-        path = os.path.join(out, "dambreak_%03d.png" % k)
-        simple.SaveScreenshot(path, view, ImageResolution=list(size))
-        paths.append(path)
+    paths = save_frames(view, fluid.TimestepValues, out, "dambreak_%03d.png", size)
     # The same frames as a water surface: the fluid's cache serves every time again, only the surface is computed.
     simple.Hide(fluid, view)
     surface = MeshlessSurface(Input=fluid, Method="SPH")  # noqa: F821
     water = simple.Show(surface, view)
     simple.ColorBy(water, ("POINTS", "Velocity", "Magnitude"))
     water.Specular = 0.3
-    for k, t in enumerate(fluid.TimestepValues):
-        view.ViewTime = t
-        simple.Render(view)
-        path = os.path.join(out, "dambreak_surface_%03d.png" % k)
-        simple.SaveScreenshot(path, view, ImageResolution=list(size))
-        paths.append(path)
+    paths += save_frames(view, fluid.TimestepValues, out, "dambreak_surface_%03d.png", size)
     simple.Delete(view)
     return paths
 

@@ -21,7 +21,7 @@ import os
 
 from paraview import simple
 
-from demo_common import load_plugin, new_view
+from demo_common import black_scalar_bar, load_plugin, new_view
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -43,10 +43,7 @@ def intensity_colours(display, view, title):
     lut.ApplyPreset("Viridis (matplotlib)", True)
     lut.RescaleTransferFunction(0.0, 1.0)
     display.SetScalarBarVisibility(view, True)
-    bar = simple.GetScalarBar(lut, view)
-    bar.Title = title
-    bar.ComponentTitle = ""
-    bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
+    black_scalar_bar(lut, view, title)
 
 
 def holes(cloud, out, size):
@@ -65,11 +62,7 @@ def holes(cloud, out, size):
     lut.AutomaticRescaleRangeMode = "Never"
     lut.RescaleTransferFunction(0.0, 0.15)
     display.SetScalarBarVisibility(view, True)
-    bar = simple.GetScalarBar(lut, view)
-    bar.Title = "DistanceToData"
-    bar.ComponentTitle = ""
-    bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
-    bar.WindowLocation = "Upper Left Corner"
+    black_scalar_bar(lut, view, "DistanceToData").WindowLocation = "Upper Left Corner"
     view.CameraPosition = [1.45, -2.5, -3.0]
     view.CameraFocalPoint = [1.45, 0.0, 0.0]
     view.CameraViewUp = [0, 0, 1]

@@ -19,7 +19,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
 import spheric_test2  # noqa: E402  (the scene: tank, column, box)
-from demo_common import new_view  # noqa: E402
+from demo_common import new_view, save_frames, speed_colours  # noqa: E402
 
 
 def spheric2(out, dx=0.05, end_time=1.0, interval=0.25, size=(960, 540)):
@@ -44,19 +44,8 @@ def spheric2(out, dx=0.05, end_time=1.0, interval=0.25, size=(960, 540)):
     obstacle.AmbientColor = obstacle.DiffuseColor = [0.55, 0.45, 0.35]
     surface = namespace.get("MeshlessSurface", getattr(simple, "MeshlessSurface", None))(Input=fluid, Method="SPH")
     water = simple.Show(surface, view)
-    simple.ColorBy(water, ("POINTS", "Velocity", "Magnitude"))
     water.Specular = 0.3
-    lut = simple.GetColorTransferFunction("Velocity")
-    lut.ApplyPreset("Jet", True)
-    lut.RescaleTransferFunction(0.0, 4.0)
-    water.SetScalarBarVisibility(view, True)
-    bar = simple.GetScalarBar(lut, view)
-    bar.Title = "speed"
-    bar.ComponentTitle = "(m/s)"
-    bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
-    bar.TitleFontSize = 18
-    bar.LabelFontSize = 16
-    bar.RangeLabelFormat = "%-#.1f"
+    bar = speed_colours(water, view, 4.0)
     bar.ScalarBarLength = 0.5
     bar.WindowLocation = "Upper Left Corner"
     view.CameraPosition = [0.9, -2.2, 1.9]
@@ -64,13 +53,7 @@ def spheric2(out, dx=0.05, end_time=1.0, interval=0.25, size=(960, 540)):
     view.CameraViewUp = [0, 0, 1]
     simple.ResetCamera(view)  # the tank's outline fills the view ...
     simple.GetActiveCamera().Dolly(1.6)  # ... then closer
-    paths = []
-    for k, t in enumerate(t for t in fluid.TimestepValues if t > 0.0):
-        view.ViewTime = t
-        simple.Render(view)
-        path = os.path.join(out, "spheric2_%03d.png" % k)
-        simple.SaveScreenshot(path, view, ImageResolution=list(size))
-        paths.append(path)
+    paths = save_frames(view, [t for t in fluid.TimestepValues if t > 0.0], out, "spheric2_%03d.png", size)
     simple.Delete(view)
     return paths
 
