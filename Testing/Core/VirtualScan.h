@@ -60,9 +60,10 @@ struct ScanCloud
 };
 
 /// Range images of resolution x resolution rays per viewpoint, over a square field of view that just holds the
-/// shape; noise sigma along each ray.
+/// shape; noise sigma along each ray (with depthSquared, sigma (t / D)^2 at range t from a viewpoint at distance D
+/// from the origin: a triangulation scanner's error grows with the square of the range).
 inline ScanCloud Scan(bool torus, const std::vector<std::array<double, 3>>& eyes, int resolution, double sigma,
-  unsigned seed = 7)
+  unsigned seed = 7, bool depthSquared = false)
 {
   ScanCloud cloud;
   std::mt19937_64 rng(seed);
@@ -126,7 +127,7 @@ inline ScanCloud Scan(bool torus, const std::vector<std::array<double, 3>>& eyes
         {
           continue; // grazing (a real scanner drops returns beyond about 75 degrees of incidence)
         }
-        const double e = sigma * gauss(rng);
+        const double e = sigma * (depthSquared ? (t / distance) * (t / distance) : 1.0) * gauss(rng);
         for (int a = 0; a < 3; ++a)
         {
           cloud.Points.push_back(p[a] + e * d[a]);

@@ -45,6 +45,8 @@ constexpr double FlagFloor = 0.01;
 // from 1.155 x the noise.
 constexpr double FlagSignificance = 3.5;
 constexpr double MaxCrossing = 0.2;
+// A jet's local noise (LocalNoise): the misfit over the neighbours within half its radius, from this many of them.
+constexpr size_t LocalNoiseMinimum = 16;
 constexpr double NoiseAgreement = 1.5; // the jets' noise at most this many times the PCA spread's (thin parts)
 constexpr double MaxTurn = 0.2; // radians: the most the curvature may turn the normal between a point and its donor
 constexpr Index SamplePoints = 2048; // the scale's sample (CloudSample: by a hash of the positions)
@@ -890,6 +892,37 @@ bool NearestOfList(const double* sorted, const Index* pos, const double* r2, siz
   return true;
 }
 
+/// A jet's misfit over `count` neighbours (of which it fits at most MaxFit) as an estimate of the noise: its six
+/// coefficients take up six of the degrees of freedom, rms^2 n / (n - 6).
+double CorrectedMisfit(double rms, size_t count)
+{
+  const double n = static_cast<double>(std::min(count, MaxFit));
+  return n > 6.0 ? rms * std::sqrt(n / (n - 6.0)) : rms;
+}
+/// The noise around x where a crease can hardly show: the corrected misfit of the jet over the neighbours within
+/// half the radius (`positions` and `dist2`: those within the radius; `half`: scratch). A crease's misfit grows
+/// with the radius (about twice from R / 2 to R for a V), noise's does not: a jet that misfits by more than the
+/// cloud's median noise is taken for one across a crease only if it also misfits beyond this (SurfaceNormals.h,
+/// "Sharp features"). 0 where fewer than LocalNoiseMinimum neighbours lie that near.
+double LocalNoise(const double* sorted, const std::vector<Index>& positions, const std::vector<double>& dist2,
+  const double x[3], double radius, std::vector<Index>& half)
+{
+  half.clear();
+  const double limit = 0.25 * radius * radius;
+  for (size_t c = 0; c < positions.size(); ++c)
+  {
+    if (dist2[c] <= limit)
+    {
+      half.push_back(positions[c]);
+    }
+  }
+  if (half.size() < LocalNoiseMinimum)
+  {
+    return 0.0;
+  }
+  const JetFit fit = FitJet(sorted, half.data(), half.size(), x, 0.5 * radius);
+  return fit.Valid ? CorrectedMisfit(fit.Rms, half.size()) : 0.0;
+}
 /// Sharp features. A jet whose neighbourhood reaches across a crease (a cube's edge or corner) misfits its
 /// neighbours far beyond the noise and smears the normal. Such a point (misfit over FlagMisfit x the cloud's
 /// noise, or fewer standard errors of a large fit's misfit: FlagSignificance, and over FlagFloor x its radius)
@@ -915,7 +948,7 @@ void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vect
   detail::Buffer<double> replacedCurvature(meanCurvature ? static_cast<size_t>(nv) : 0, 0.0);
   struct Buffers
   {
-    std::vector<Index> Positions;
+    std::vector<Index> Positions, Half;
     std::vector<double> Dist2;
   };
   PerThread<Buffers> buffers;
@@ -953,6 +986,12 @@ void SharpFeatures(const NeighborGrid& grid, NormalField& field, const std::vect
       }
       const double* x = sorted + 3 * s;
       grid.FindWithinRadiusPositions(x, radius, mine.Positions, mine.Dist2);
+      // The point's own noise, not a crease: its jet misfits no more than the jet over half its radius does.
+      const double local = LocalNoise(sorted, mine.Positions, mine.Dist2, x, radius, mine.Half);
+      if (local > 0.0 && CorrectedMisfit(rms[s], mine.Positions.size()) <= FlagMisfit * local)
+      {
+        continue;
+      }
       // The neighbour whose jet fits best, at most 1 / FlagMisfit as badly, and passes through the point.
       Index best = -1;
       double bestRms = rms[s] / FlagMisfit;
@@ -1139,9 +1178,11 @@ void EstimateNormalRadius(
   const double* sorted = grid.SortedPoints();
   std::vector<double> rms, curvature;
   std::vector<double> localRms(static_cast<size_t>(mineCount), 0.0), localCurvature(static_cast<size_t>(mineCount));
+  // Each sample jet's misfit over its local noise (LocalNoise), as the creases' rule below compares it.
+  std::vector<double> localExcess(static_cast<size_t>(mineCount), 0.0), excess;
   struct Buffers
   {
-    std::vector<Index> Positions;
+    std::vector<Index> Positions, Half;
     std::vector<double> Dist2;
   };
   PerThread<Buffers> buffers;
@@ -1157,11 +1198,14 @@ void EstimateNormalRadius(
         const JetFit fit = FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, radius);
         localRms[j] = fit.Valid ? fit.Rms : 0.0;
         localCurvature[j] = fit.Valid ? fit.Curvature : 0.0;
+        const double local = fit.Valid ? LocalNoise(sorted, mine.Positions, mine.Dist2, x, radius, mine.Half) : 0.0;
+        localExcess[j] = local > 0.0 ? CorrectedMisfit(fit.Rms, mine.Positions.size()) / local : HUGE_VAL;
       }
     });
     scale.SampleShortfall =
       std::max(scale.SampleShortfall, SampleShortfall(d, sample, sorted, [radius](size_t) { return radius; }));
     rms = sample.Gather(d, localRms);
+    excess = sample.Gather(d, localExcess);
     curvature = sample.Gather(d, localCurvature);
     // The misfit also grows where a neighbourhood takes in two sheets (a part thinner than it): the noise is
     // at most NoiseAgreement x the PCA spread at the fits' own radius (CloudScale::Noise), which stays small
@@ -1190,14 +1234,16 @@ void EstimateNormalRadius(
     radius = std::max(rk, CurvatureReach / scale.Curvature);
     fitSample();
   }
-  // Creases (a cube's edges): where more than MaxCrossing of the sample's jets misfit beyond the noise (they
-  // reach across one), the radius shrinks.
+  // Creases (a cube's edges): where more than MaxCrossing of the sample's jets misfit beyond the noise, both the
+  // cloud's median and their own local noise (they reach across one), the radius shrinks. (Against the median
+  // alone a range scan's noisier half, its noise growing with the square of the range, counted as creases.)
   for (int round = 0; round < 6 && radius > rk; ++round)
   {
     Index crossing = 0;
-    for (double r : rms)
+    for (size_t q = 0; q < rms.size(); ++q)
     {
-      crossing += r > FlagMisfit * scale.FitNoise && r > FlagFloor * radius ? 1 : 0;
+      const double r = rms[q];
+      crossing += r > FlagMisfit * scale.FitNoise && excess[q] > FlagMisfit && r > FlagFloor * radius ? 1 : 0;
     }
     if (static_cast<double>(crossing) <= MaxCrossing * static_cast<double>(samples))
     {

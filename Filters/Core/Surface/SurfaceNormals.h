@@ -25,12 +25,18 @@
  * noise's tilt below 0.0025 rad (rounds of radius -> misfit -> radius, as a neighbourhood smaller than the noise
  * hides it; Mitra, Nguyen & Guibas 2004 choose the radius the same way), capped at 0.9 / the median curvature
  * of the jets, at about 1000 neighbours, and shrunk while more than 20 % of the sample's jets misfit beyond
- * 1.25 sigma (they reach across creases). Measured (150k points, torus/sphere/cube at noise 0-1.2 % of the
- * diagonal): within 10 % of the best of PCA over 18, 112, 450 nearest, mostly well below.
+ * 1.25 sigma and beyond 1.25 x their local noise (they reach across creases). The local noise is the misfit of the
+ * jet over the neighbours within half its radius (corrected for the jet's six coefficients): a crease's misfit grows
+ * with the radius (about twice from R / 2 to R for a V), noise's does not. Without it a range scan's noise, which
+ * grows with the square of the range and spans several times its median over one view, made its noisier half
+ * count as creases (the radius fell to r_k and SharpFeatures replaced those normals: CGAL's jet over 112
+ * neighbours was 2-5 times better on the virtual scans; now the default beats it on each). Measured (150k points,
+ * torus/sphere/cube at noise 0-1.2 % of the diagonal, and the four virtual scans): better than the best of PCA over
+ * 18, 112, 450 nearest and CGAL's jet over 18 and 112 on every cloud.
  * SupportRadius > 0 replaces all of this with one fixed radius; AdaptToNoise off keeps r_k.
  *
- * Sharp features: a point whose jet misfits its neighbours by more than 1.25 sigma (and 1 % of R) reaches
- * across a crease; it takes the normal of the neighbour (within R, and within 0.2 rad / the median curvature)
+ * Sharp features: a point whose jet misfits its neighbours by more than 1.25 sigma (and 1 % of R) and by more than
+ * 1.25 x its local noise (above) reaches across a crease; it takes the normal of the neighbour (within R, and within 0.2 rad / the median curvature)
  * whose jet fits best and passes through the point: the neighbourhood on its side of the crease. Points in the crease itself (no such side) take a jet
  * over the smallest neighbourhood the noise allows.
  *
