@@ -1,5 +1,5 @@
 """What the demo scripts share (demo_scan.py, demo_dambreak.py, demo_spheric2.py): the plugin, a white render view,
-scalar bars that read on it, colouring by speed, and frames saved over time."""
+a box from bounds, scalar bars that read on it, colouring by speed, and frames saved over time."""
 import os
 import sys
 
@@ -25,6 +25,13 @@ def new_view(size):
     except AttributeError:
         pass
     return view
+
+
+def bounds_box(bounds):
+    """A Box source filling bounds [x0, x1, y0, y1, z0, z1]."""
+    return simple.Box(XLength=bounds[1] - bounds[0], YLength=bounds[3] - bounds[2], ZLength=bounds[5] - bounds[4],
+                      Center=[0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]),
+                              0.5 * (bounds[4] + bounds[5])])
 
 
 def black_scalar_bar(lut, view, title, component=""):

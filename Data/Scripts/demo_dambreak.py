@@ -12,7 +12,7 @@ import os
 
 from paraview import simple
 
-from demo_common import load_plugin, new_view, save_frames, speed_colours
+from demo_common import bounds_box, load_plugin, new_view, save_frames, speed_colours
 
 
 def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
@@ -23,8 +23,7 @@ def dam_break(out, spacing=0.01, end_time=0.35, interval=0.05, size=(960, 540)):
     fluid = SPHFluid(Dimension=3, ParticleSpacing=spacing, FluidBounds=[0.0, 0.64, 0.0, 0.32, 0.0, 0.32],  # noqa: F821
                      DomainBounds=domain, Viscosity=0.001, CFLNumber=0.25, TimeStep=0.002,
                      EndTime=end_time, OutputInterval=interval)
-    tank = simple.Box(XLength=domain[1] - domain[0], YLength=domain[3] - domain[2], ZLength=domain[5] - domain[4],
-                      Center=[(domain[0] + domain[1]) / 2, (domain[2] + domain[3]) / 2, (domain[4] + domain[5]) / 2])
+    tank = bounds_box(domain)
     view = new_view(size)
     outline = simple.Show(tank, view)
     outline.SetRepresentationType("Outline")

@@ -925,8 +925,8 @@ double LocalNoise(const double* sorted, const std::vector<Index>& positions, con
 }
 /// Sharp features. A jet whose neighbourhood reaches across a crease (a cube's edge or corner) misfits its
 /// neighbours far beyond the noise and smears the normal. Such a point (misfit over FlagMisfit x the cloud's
-/// noise, or fewer standard errors of a large fit's misfit: FlagSignificance, and over FlagFloor x its radius)
-/// takes the normal of the neighbour, within its radius, whose jet
+/// noise, or fewer standard errors of a large fit's misfit: FlagSignificance, over FlagFloor x its radius, and
+/// over FlagMisfit x its own LocalNoise) takes the normal of the neighbour, within its radius, whose jet
 /// fits with the smallest misfit (at most 1 / FlagMisfit of its own) among those whose jet passes through the
 /// point (within 3 x max(noise, that jet's misfit) of its tangent plane, plus the curvature's sag): the
 /// neighbourhood that lies on the point's side of the crease. Only neighbours within MaxTurn / the median
@@ -1188,7 +1188,9 @@ void EstimateNormalRadius(
   PerThread<Buffers> buffers;
   const double cap = scale.Spacing * std::sqrt(MaxNeighbors / Pi);
   double radius = rk;
-  auto fitSample = [&]() {
+  // withExcess: also each jet's misfit over its local noise, which only the creases' rule reads (not the noise's
+  // rounds, whose last fit the curvature's fitSample repeats).
+  auto fitSample = [&](bool withExcess) {
     ParallelFor(mineCount, 16, [&](Index begin, Index end) {
       Buffers& mine = buffers.Local();
       for (Index j = begin; j < end; ++j)
@@ -1198,14 +1200,20 @@ void EstimateNormalRadius(
         const JetFit fit = FitJet(sorted, mine.Positions.data(), mine.Positions.size(), x, radius);
         localRms[j] = fit.Valid ? fit.Rms : 0.0;
         localCurvature[j] = fit.Valid ? fit.Curvature : 0.0;
-        const double local = fit.Valid ? LocalNoise(sorted, mine.Positions, mine.Dist2, x, radius, mine.Half) : 0.0;
-        localExcess[j] = local > 0.0 ? CorrectedMisfit(fit.Rms, mine.Positions.size()) / local : HUGE_VAL;
+        if (withExcess)
+        {
+          const double local = fit.Valid ? LocalNoise(sorted, mine.Positions, mine.Dist2, x, radius, mine.Half) : 0.0;
+          localExcess[j] = local > 0.0 ? CorrectedMisfit(fit.Rms, mine.Positions.size()) / local : HUGE_VAL;
+        }
       }
     });
     scale.SampleShortfall =
       std::max(scale.SampleShortfall, SampleShortfall(d, sample, sorted, [radius](size_t) { return radius; }));
     rms = sample.Gather(d, localRms);
-    excess = sample.Gather(d, localExcess);
+    if (withExcess)
+    {
+      excess = sample.Gather(d, localExcess);
+    }
     curvature = sample.Gather(d, localCurvature);
     // The misfit also grows where a neighbourhood takes in two sheets (a part thinner than it): the noise is
     // at most NoiseAgreement x the PCA spread at the fits' own radius (CloudScale::Noise), which stays small
@@ -1217,7 +1225,7 @@ void EstimateNormalRadius(
   // neighbourhood smaller than the noise hides it: rounds until the radius settles.
   for (int round = 0; round < 6; ++round)
   {
-    fitSample();
+    fitSample(false);
     const double next = std::max(rk, std::min(NoiseRadius(scale.FitNoise, scale.Spacing, NormalTilt), cap));
     const bool settled = std::fabs(next - radius) < 0.05 * radius;
     radius = next;
@@ -1228,11 +1236,11 @@ void EstimateNormalRadius(
   }
   // The jet's bias (third order) kept small by staying within CurvatureReach / curvature, the curvature
   // measured at the noise's radius (at smaller radii the noise makes it up).
-  fitSample();
+  fitSample(true);
   if (scale.Curvature > 0.0 && CurvatureReach / scale.Curvature < radius)
   {
     radius = std::max(rk, CurvatureReach / scale.Curvature);
-    fitSample();
+    fitSample(true);
   }
   // Creases (a cube's edges): where more than MaxCrossing of the sample's jets misfit beyond the noise, both the
   // cloud's median and their own local noise (they reach across one), the radius shrinks. (Against the median
@@ -1250,7 +1258,7 @@ void EstimateNormalRadius(
       break;
     }
     radius = std::max(rk, 0.8 * radius);
-    fitSample();
+    fitSample(true);
   }
   scale.NormalRadius = radius > rk ? radius : 0.0;
 }
